@@ -1,0 +1,1 @@
+"""Axisymmetric large-deformation elastic–plastic FE solver for sphere contact (DESIGN §4)."""

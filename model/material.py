@@ -1,0 +1,175 @@
+"""Elastic–plastic materials: elastic constants and a monotone flow curve.
+
+The flow curve σ_f(ε_p) is the uniaxial flow stress against equivalent plastic
+strain (DESIGN §1). Two kinds:
+
+* Ludwik, ``σ_f = σ_Y + K ε_p**n`` (K = 0: elastic–perfectly plastic,
+  n = 1: linear hardening);
+* tabulated, any monotone (non-decreasing) curve, interpolated linearly and
+  continued beyond the last point with the last segment's slope.
+
+A rigid material has E = ∞ (E' = ∞); it never yields.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Material"]
+
+#: Ludwik slope K n ε^(n-1) is infinite at ε_p = 0 for n < 1; it is evaluated at
+#: max(ε_p, EPS_SLOPE_FLOOR) so that Newton solvers get a large but finite slope.
+EPS_SLOPE_FLOOR = 1e-12
+
+
+def _check_finite(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class Material:
+    """Isotropic elastic–plastic material.
+
+    Parameters
+    ----------
+    E : Young's modulus, > 0 (``math.inf`` for a rigid body: use ``Material.rigid()``).
+    nu : Poisson's ratio, in (-1, 0.5).
+    sigma_y : initial yield stress σ_Y, > 0.
+    K : Ludwik hardening modulus, >= 0 (0: perfectly plastic).
+    n : Ludwik hardening exponent, >= 0.
+    eps_table, sigma_table : tabulated flow curve (use ``Material.from_table``).
+    """
+
+    E: float
+    nu: float
+    sigma_y: float = math.inf
+    K: float = 0.0
+    n: float = 1.0
+    eps_table: tuple[float, ...] | None = field(default=None, repr=False)
+    sigma_table: tuple[float, ...] | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        E = float(self.E)
+        if math.isnan(E) or E <= 0.0:
+            raise ValueError(f"E (Young's modulus) must be > 0 (or inf for rigid), got {self.E!r}")
+        nu = _check_finite("nu", self.nu)
+        if not -1.0 < nu < 0.5:
+            raise ValueError(f"nu (Poisson's ratio) must lie in (-1, 0.5), got {nu!r}")
+        if math.isinf(E):
+            return  # rigid: plastic parameters are irrelevant
+        sy = float(self.sigma_y)
+        if math.isnan(sy) or sy <= 0.0:
+            raise ValueError(f"sigma_y (yield stress) must be > 0 (inf: elastic), got {self.sigma_y!r}")
+        if self.eps_table is None:
+            K = _check_finite("K", self.K)
+            n = _check_finite("n", self.n)
+            if K < 0.0:
+                raise ValueError(f"K (Ludwik hardening modulus) must be >= 0, got {K!r}")
+            if n < 0.0:
+                raise ValueError(f"n (Ludwik hardening exponent) must be >= 0, got {n!r}")
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_table(cls, E: float, nu: float, eps_p, sigma) -> Material:
+        """Material with a tabulated flow curve σ_f(ε_p).
+
+        ``eps_p`` must start at 0 and increase strictly; ``sigma`` must be positive
+        and non-decreasing; at least two points.
+        """
+        eps = np.asarray(eps_p, dtype=float)
+        sig = np.asarray(sigma, dtype=float)
+        if eps.ndim != 1 or sig.ndim != 1 or eps.shape != sig.shape:
+            raise ValueError(
+                "eps_p and sigma must be 1-D arrays of equal length, "
+                f"got shapes {eps.shape} and {sig.shape}"
+            )
+        if eps.size < 2:
+            raise ValueError(f"flow table needs at least 2 points, got {eps.size}")
+        if not (np.all(np.isfinite(eps)) and np.all(np.isfinite(sig))):
+            raise ValueError("eps_p and sigma must be finite (no NaN/inf)")
+        if eps[0] != 0.0:
+            raise ValueError(f"eps_p must start at 0, got eps_p[0] = {eps[0]!r}")
+        if np.any(np.diff(eps) <= 0.0):
+            raise ValueError("eps_p must be strictly increasing")
+        if sig[0] <= 0.0:
+            raise ValueError(f"sigma must be > 0, got sigma[0] = {sig[0]!r}")
+        if np.any(np.diff(sig) < 0.0):
+            raise ValueError("sigma must be non-decreasing (a monotone flow curve)")
+        return cls(
+            E=E, nu=nu, sigma_y=float(sig[0]), K=0.0, n=1.0,
+            eps_table=tuple(eps.tolist()), sigma_table=tuple(sig.tolist()),
+        )
+
+    @classmethod
+    def rigid(cls, nu: float = 0.3) -> Material:
+        """A rigid body: E = ∞, E' = ∞."""
+        return cls(E=math.inf, nu=nu)
+
+    @classmethod
+    def elastic(cls, E: float, nu: float) -> Material:
+        """A purely elastic body (σ_Y = ∞)."""
+        return cls(E=E, nu=nu, sigma_y=math.inf)
+
+    # ------------------------------------------------------------------ elastic constants
+    @property
+    def is_rigid(self) -> bool:
+        return math.isinf(self.E)
+
+    @property
+    def is_tabulated(self) -> bool:
+        return self.eps_table is not None
+
+    @property
+    def E_prime(self) -> float:
+        """Plane-strain modulus E' = E/(1 − ν²) (DESIGN §1)."""
+        return self.E / (1.0 - self.nu**2)
+
+    @property
+    def shear_modulus(self) -> float:
+        """G = E / (2(1 + ν))."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def bulk_modulus(self) -> float:
+        """κ = E / (3(1 − 2ν))."""
+        return self.E / (3.0 * (1.0 - 2.0 * self.nu))
+
+    # ------------------------------------------------------------------ flow curve
+    def flow_stress(self, eps_p):
+        """Uniaxial flow stress σ_f(ε_p), vectorised; ε_p < 0 is treated as 0."""
+        e = np.maximum(np.asarray(eps_p, dtype=float), 0.0)
+        if self.eps_table is not None:
+            et = np.asarray(self.eps_table)
+            st = np.asarray(self.sigma_table)
+            slope_end = (st[-1] - st[-2]) / (et[-1] - et[-2])
+            return np.where(e <= et[-1], np.interp(e, et, st), st[-1] + slope_end * (e - et[-1]))
+        if self.K == 0.0:
+            return np.full_like(e, self.sigma_y)
+        return self.sigma_y + self.K * e**self.n
+
+    def flow_slope(self, eps_p):
+        """Hardening slope dσ_f/dε_p, vectorised (right derivative on tables)."""
+        e = np.maximum(np.asarray(eps_p, dtype=float), 0.0)
+        if self.eps_table is not None:
+            et = np.asarray(self.eps_table)
+            st = np.asarray(self.sigma_table)
+            slopes = np.diff(st) / np.diff(et)
+            idx = np.clip(np.searchsorted(et, e, side="right") - 1, 0, slopes.size - 1)
+            return slopes[idx]
+        if self.K == 0.0 or self.n == 0.0:
+            return np.zeros_like(e)
+        return self.K * self.n * np.maximum(e, EPS_SLOPE_FLOOR) ** (self.n - 1.0)
+
+    def describe(self) -> dict:
+        """Plain-dict description (for HDF5 attributes and JSON)."""
+        d = {"E": self.E, "nu": self.nu, "sigma_y": self.sigma_y, "K": self.K, "n": self.n}
+        if self.eps_table is not None:
+            d = {"E": self.E, "nu": self.nu, "eps_table": list(self.eps_table),
+                 "sigma_table": list(self.sigma_table)}
+        return d

@@ -1,0 +1,7 @@
+"""spherecontact: contact force and area between two elastic–plastic spheres.
+
+Stages (DESIGN.md): ``fem`` (reference FE solver) → ``data`` → ``calibration``
+→ ``model`` (closed-form unified law) ← ``validation``.
+"""
+
+__version__ = "0.1.0"
