@@ -1,5 +1,25 @@
-"""Closed-form unified contact model for two elastic–plastic spheres (DESIGN §1–3)."""
+"""Closed-form unified contact model for two elastic–plastic spheres (DESIGN §1–3).
 
+Public API::
+
+    from spherecontact.model import Material, Sphere, contact
+    st = contact(Sphere(1e-3, m), Sphere(math.inf, Material.rigid()), h)
+    st.F, st.a, st.h1, st.h2, st.stiffness
+
+``ContactLaw`` is the tabulated fast path for many contacts of one sphere pair.
+"""
+
+from .coefficients import Coefficients, default_coefficients, load_coefficients
+from .contact import ContactState, contact
 from .material import Material
+from .sphere import Sphere
 
-__all__ = ["Material"]
+__all__ = [
+    "Material",
+    "Sphere",
+    "contact",
+    "ContactState",
+    "Coefficients",
+    "load_coefficients",
+    "default_coefficients",
+]

@@ -1,0 +1,101 @@
+"""Total-Lagrangian axisymmetric assembly: internal force and tangent (hot loop).
+
+Virtual work over the reference meridian section, dV₀ = 2π R dR dZ:
+
+    f_int = ∫ Bᵀ P dV₀,      K = ∫ Bᵀ A B dV₀,      A = ∂P/∂F
+
+with the deformation-gradient vector F = [F_rr, F_rz, F_zr, F_zz, F_θθ] =
+[1 + ∂u_r/∂R, ∂u_r/∂Z, ∂u_z/∂R, 1 + ∂u_z/∂Z, 1 + u_r/R] (the hoop stretch
+included). B is built once from scikit-fem's basis in the reference
+configuration; each Newton iteration is two einsums and a bincount into a
+fixed CSR pattern (about 10× faster than form assembly, see notes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import skfem
+
+from .mesh import HemisphereMesh
+
+#: Element kinds: quadratic serendipity with 2×2 (reduced) Gauss points — does
+#: not lock in isochoric flow — and bilinear with 2×2 (full) Gauss points, which
+#: locks (kept for the locking demonstration only).
+ELEMENTS = {"q8r": (skfem.ElementQuadS2, 3), "q4": (skfem.ElementQuad1, 3)}
+
+
+class Discretisation:
+    """Element arrays of one hemisphere mesh: B, weights, dof maps, CSR pattern."""
+
+    def __init__(self, hmesh: HemisphereMesh, element: str = "q8r"):
+        if element not in ELEMENTS:
+            raise ValueError(f"element must be one of {sorted(ELEMENTS)}, got {element!r}")
+        cls, intorder = ELEMENTS[element]
+        self.element = element
+        self.hmesh = hmesh
+        basis = skfem.Basis(hmesh.mesh, cls(), intorder=intorder)
+        self.basis = basis
+        nbf, nel = basis.Nbfun, basis.nelems
+        nqp = basis.X.shape[1]
+        self.n_nodes = basis.N
+        self.n_dofs = 2 * basis.N
+        self.n_elements, self.n_qp = nel, nqp
+        xq = basis.mapping.F(basis.X)  # (2, nel, nqp) reference coordinates of the points
+        self.R_qp = xq[0]
+        self.weights = (2.0 * np.pi * xq[0] * basis.dx).reshape(-1)  # (nel*nqp,)
+        phi = np.stack([basis.basis[i][0].value for i in range(nbf)])  # (nbf, nel, nqp)
+        dphi = np.stack([basis.basis[i][0].grad for i in range(nbf)])  # (nbf, 2, nel, nqp)
+        B = np.zeros((nel, nqp, 5, nbf, 2))
+        B[:, :, 0, :, 0] = dphi[:, 0].transpose(1, 2, 0)  # ∂u_r/∂R
+        B[:, :, 1, :, 0] = dphi[:, 1].transpose(1, 2, 0)  # ∂u_r/∂Z
+        B[:, :, 2, :, 1] = dphi[:, 0].transpose(1, 2, 0)  # ∂u_z/∂R
+        B[:, :, 3, :, 1] = dphi[:, 1].transpose(1, 2, 0)  # ∂u_z/∂Z
+        B[:, :, 4, :, 0] = (phi / xq[0][None]).transpose(1, 2, 0)  # u_r/R
+        self.B = B.reshape(nel * nqp, 5, 2 * nbf)
+        nodes = basis.element_dofs  # (nbf, nel) node index = scalar dof index
+        edofs = np.stack([2 * nodes, 2 * nodes + 1], axis=-1)  # (nbf, nel, 2)
+        self.edofs = edofs.transpose(1, 0, 2).reshape(nel, 2 * nbf)
+        self.qp_dofs = np.repeat(self.edofs, nqp, axis=0)  # (nel*nqp, 2nbf)
+        self._pattern()
+
+    def _pattern(self) -> None:
+        nd = self.n_dofs
+        rows = np.repeat(self.edofs[:, :, None], self.edofs.shape[1], axis=2).ravel()
+        cols = np.repeat(self.edofs[:, None, :], self.edofs.shape[1], axis=1).ravel()
+        keys = rows.astype(np.int64) * nd + cols
+        uniq, slot = np.unique(keys, return_inverse=True)
+        self._slot = slot
+        self._nnz = uniq.size
+        r, c = np.divmod(uniq, nd)
+        self._indices = c.astype(np.int32)
+        self._indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nd))]).astype(np.int32)
+
+    # ------------------------------------------------------------------ kinematics
+    def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
+        """F vector (5, n_points) at the quadrature points for nodal displacements u."""
+        ue = u[self.edofs]  # (nel, 2nbf)
+        grad = np.einsum("eqkj,ej->keq", self.B.reshape(self.n_elements, self.n_qp, 5, -1), ue)
+        grad = grad.reshape(5, -1)
+        grad[0] += 1.0
+        grad[3] += 1.0
+        grad[4] += 1.0
+        return grad
+
+    # ------------------------------------------------------------------ assembly
+    def internal_force(self, P: np.ndarray) -> np.ndarray:
+        """f_int = Σ_q w_q Bᵀ P (P: (5, n_points))."""
+        fe = np.einsum("qkj,kq,q->qj", self.B, P, self.weights)
+        return np.bincount(self.qp_dofs.ravel(), weights=fe.ravel(), minlength=self.n_dofs)
+
+    def tangent(self, A: np.ndarray) -> sp.csr_matrix:
+        """K = Σ_q w_q Bᵀ A B (A: (5, 5, n_points)) on the fixed CSR pattern."""
+        AB = np.einsum("klq,qlj,q->qkj", A, self.B, self.weights)
+        Kq = np.einsum("qki,qkj->qij", self.B, AB)
+        Ke = Kq.reshape(self.n_elements, self.n_qp, *Kq.shape[1:]).sum(axis=1)
+        data = np.bincount(self._slot, weights=Ke.ravel(), minlength=self._nnz)
+        return sp.csr_matrix((data, self._indices, self._indptr), shape=(self.n_dofs,) * 2)
+
+    def integrate(self, values: np.ndarray) -> float:
+        """∫ values dV₀ over the body (values at the points)."""
+        return float(np.dot(self.weights, values))

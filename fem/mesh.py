@@ -1,0 +1,179 @@
+"""Graded quadratic mesh of one hemisphere's meridian section (DESIGN §4).
+
+The section is the quarter disk r ≥ 0, z ≤ R, r² + (z − R)² ≤ R²: the contact
+pole at the origin, the centre at (0, R), the equatorial plane z = R. gmsh
+meshes it with quadrilaterals (Frontal-Delaunay for quads, full-quad blossom
+recombination) under a background size field that is finest at the pole and
+fine along the whole arc, so the contact stays resolved from Hertz (a/R ≈ 0.02)
+to h/R = 0.5. Second order, incomplete (8-node serendipity quads): midside nodes
+lie on the true arc, so the contact surface is exact to the element's order.
+
+gmsh instead of a hand-written mapped mesh: the quarter disk with a point-graded
+and arc-graded size field has no good single structured block, and gmsh gives
+all-quad meshes with guaranteed minimum quality in ~0.05 s.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import skfem
+
+#: Allowed range of the mesh-density parameter (1 = default, 2 = 2× finer).
+DENSITY_RANGE = (0.25, 4.0)
+
+# Element sizes at density 1, in units of R.
+SIZE_POLE = 0.0025  # at the contact pole (r < 0.08 R)
+SIZE_ARC = 0.02  # along the whole arc
+SIZE_BULK = 0.10  # far from the arc
+
+
+@dataclass(frozen=True)
+class HemisphereMesh:
+    """Meridian mesh of a hemisphere of radius ``radius`` (pole at origin).
+
+    Attributes
+    ----------
+    mesh : skfem.MeshQuad2 (quadratic geometry, curved arc edges).
+    X : (2, n_nodes) reference nodal coordinates (r, z) of the serendipity nodes.
+    surface : node indices on the arc, ordered from the pole outwards.
+    axis, equator : node indices on r = 0 and on z = R.
+    radius, density : the inputs.
+    """
+
+    mesh: skfem.MeshQuad2
+    X: np.ndarray
+    surface: np.ndarray
+    axis: np.ndarray
+    equator: np.ndarray
+    radius: float
+    density: float
+
+    @property
+    def n_nodes(self) -> int:
+        return self.X.shape[1]
+
+    @property
+    def n_elements(self) -> int:
+        return self.mesh.nelements
+
+
+def check_density(density: float) -> float:
+    d = float(density)
+    lo, hi = DENSITY_RANGE
+    if not np.isfinite(d) or not lo <= d <= hi:
+        raise ValueError(f"mesh density must lie in [{lo}, {hi}], got {density!r}")
+    return d
+
+
+def _gmsh_quad8(radius: float, density: float, linear: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Run gmsh; return node coordinates (2, n) and quad connectivity (n_per_el, n_el)."""
+    import gmsh
+
+    R = radius
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("hemisphere")
+        geo = gmsh.model.geo
+        pole = geo.addPoint(0.0, 0.0, 0.0)
+        centre = geo.addPoint(0.0, R, 0.0)
+        edge = geo.addPoint(R, R, 0.0)
+        axis = geo.addLine(pole, centre)
+        equator = geo.addLine(centre, edge)
+        arc = geo.addCircleArc(edge, centre, pole)
+        geo.addPlaneSurface([geo.addCurveLoop([axis, equator, arc])])
+        geo.synchronize()
+
+        field = gmsh.model.mesh.field
+        d_pole = field.add("Distance")
+        field.setNumbers(d_pole, "PointsList", [pole])
+        t_pole = field.add("Threshold")
+        field.setNumber(t_pole, "InField", d_pole)
+        for key, val in (("SizeMin", SIZE_POLE * R / density), ("SizeMax", SIZE_BULK * R / density),
+                         ("DistMin", 0.08 * R), ("DistMax", 0.6 * R)):
+            field.setNumber(t_pole, key, val)
+        d_arc = field.add("Distance")
+        field.setNumbers(d_arc, "CurvesList", [arc])
+        field.setNumber(d_arc, "Sampling", 500)
+        t_arc = field.add("Threshold")
+        field.setNumber(t_arc, "InField", d_arc)
+        for key, val in (("SizeMin", SIZE_ARC * R / density), ("SizeMax", SIZE_BULK * R / density),
+                         ("DistMin", 0.03 * R), ("DistMax", 0.4 * R)):
+            field.setNumber(t_arc, key, val)
+        both = field.add("Min")
+        field.setNumbers(both, "FieldsList", [t_pole, t_arc])
+        field.setAsBackgroundMesh(both)
+        for key, val in (("Mesh.MeshSizeExtendFromBoundary", 0), ("Mesh.MeshSizeFromPoints", 0),
+                         ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.Algorithm", 8),
+                         ("Mesh.RecombineAll", 1), ("Mesh.RecombinationAlgorithm", 2),
+                         ("Mesh.SecondOrderIncomplete", 1), ("Mesh.Smoothing", 10),
+                         ("General.NumThreads", 1), ("Mesh.RandomSeed", 1)):
+            gmsh.option.setNumber(key, val)
+        gmsh.model.mesh.generate(2)
+        if not linear:
+            gmsh.model.mesh.setOrder(2)
+        types, _, conn = gmsh.model.mesh.getElements(2)
+        names = [gmsh.model.mesh.getElementProperties(t)[0] for t in types]
+        want = "Quadrilateral 4" if linear else "Quadrilateral 8"
+        if names != [want]:
+            raise RuntimeError(f"gmsh returned {names}, expected only {want!r}")
+        tags, xyz, _ = gmsh.model.mesh.getNodes()
+    finally:
+        gmsh.finalize()
+    index = np.empty(int(tags.max()) + 1, dtype=np.int64)
+    index[tags.astype(np.int64)] = np.arange(tags.size)
+    X = xyz.reshape(-1, 3)[:, :2].T.copy()
+    nper = 4 if linear else 8
+    t = index[conn[0].astype(np.int64)].reshape(-1, nper).T
+    # counter-clockwise corners (positive Jacobian)
+    x, y = X[0, t[:4]], X[1, t[:4]]
+    area = 0.5 * np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y, axis=0)
+    flip = area < 0
+    if np.any(flip):
+        order = [0, 3, 2, 1] if linear else [0, 3, 2, 1, 7, 6, 5, 4]
+        t[:, flip] = t[order][:, flip]
+    return X, t
+
+
+def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False) -> HemisphereMesh:
+    """Graded all-quad meshing of the hemisphere's meridian section.
+
+    Parameters
+    ----------
+    radius : sphere radius R > 0.
+    density : mesh-density factor in ``DENSITY_RANGE``; element sizes scale as 1/density.
+    linear : 4-node quads (straight edges) instead of 8-node serendipity quads;
+        only for the locking demonstration.
+    """
+    radius = float(radius)
+    if not np.isfinite(radius) or radius <= 0:
+        raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
+    density = check_density(density)
+    Xg, tg = _gmsh_quad8(radius, density, linear)
+    if linear:
+        mesh = skfem.MeshQuad1(Xg, tg)
+        basis_mesh = mesh
+    else:
+        centre = (-(Xg[:, tg[0]] + Xg[:, tg[1]] + Xg[:, tg[2]] + Xg[:, tg[3]])
+                  + 2.0 * (Xg[:, tg[4]] + Xg[:, tg[5]] + Xg[:, tg[6]] + Xg[:, tg[7]])) / 4.0
+        ncen = centre.shape[1]
+        doflocs = np.hstack([Xg, centre])
+        t9 = np.vstack([tg, Xg.shape[1] + np.arange(ncen)[None, :]])
+        # drop gmsh nodes not used by any element (the geometry's points are all used)
+        mesh = skfem.MeshQuad2(doflocs, t9)
+        basis_mesh = mesh
+    element = skfem.ElementQuad1() if linear else skfem.ElementQuadS2()
+    dofs = skfem.Basis(basis_mesh, element, intorder=1)
+    X = dofs.doflocs
+    tol = 1e-9 * radius
+    dist = np.hypot(X[0], X[1] - radius)
+    on_arc = np.abs(dist - radius) < 1e-7 * radius
+    surface = np.flatnonzero(on_arc)
+    angle = np.arctan2(X[0, surface], radius - X[1, surface])
+    surface = surface[np.argsort(angle)]
+    axis = np.flatnonzero(np.abs(X[0]) < tol)
+    equator = np.flatnonzero(np.abs(X[1] - radius) < tol)
+    return HemisphereMesh(mesh=mesh, X=X, surface=surface, axis=axis, equator=equator,
+                          radius=radius, density=density)

@@ -1,0 +1,220 @@
+"""Finite-strain J2 plasticity, axisymmetric: Hencky elasticity + exponential-map return.
+
+Simo (1992, CMAME 99:61); de Souza Neto, Perić & Owen, *Computational Methods
+for Plasticity* (2008), Box 14.3. Per quadrature point, with F = [[F_rr, F_rz],
+[F_zr, F_zz]] ⊕ F_θθ and the stored plastic metric C_p⁻¹ (reference frame):
+
+    b_e^tr = F C_p⁻¹ Fᵀ,        ε^tr = ½ ln b_e^tr                 (trial log strain)
+    s^tr = 2μ dev ε^tr,          q^tr = √(3/2 s^tr : s^tr)
+    f = q^tr − σ_f(ε_p,n) ≤ 0 elastic; else solve
+        q^tr − 3μ Δγ − σ_f(ε_p,n + Δγ) = 0                          (radial return)
+    s = (1 − 3μΔγ/q^tr) s^tr,    τ = K tr(ε^tr) I + s               (Kirchhoff stress)
+    ε_e = ε^tr − Δγ (3/2) s^tr/q^tr,  b_e = exp(2 ε_e),  C_p⁻¹ = F⁻¹ b_e F⁻ᵀ
+    P = τ F⁻ᵀ                                                         (first Piola–Kirchhoff)
+
+Vectors of components are stacked on the first axis:
+F and P as [rr, rz, zr, zz, θθ]; C_p⁻¹ as [rr, rz, zz, θθ].
+
+The consistent tangent A = ∂P/∂F (5×5 per point) is computed by complex-step
+differentiation (Squire & Trapp 1998; Tanaka et al. 2014, CMAME 269:454): every
+operation here is complex-analytic — the 2×2 tensor log and exp are written as
+α I + β B with α, β entire functions of the invariants, so equal eigenvalues are
+no special case — and Im(P(F + i h e_k))/h is ∂P/∂F_k to machine precision.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.material import Material
+
+#: complex-step size (any tiny number works: no subtractive cancellation)
+CSTEP = 1e-30
+_SMALL = 1e-3  # |x| below which the series forms are used (truncation < 1e-21)
+
+
+@dataclass
+class PlasticState:
+    """Converged internal variables at the quadrature points."""
+
+    cp_inv: np.ndarray  # (4, N): C_p⁻¹ components rr, rz, zz, θθ
+    eps_p: np.ndarray  # (N,): equivalent plastic strain
+    dissipation: float = 0.0  # accumulated plastic dissipation (whole body)
+
+    @classmethod
+    def virgin(cls, n: int) -> PlasticState:
+        cp = np.zeros((4, n))
+        cp[0] = cp[2] = cp[3] = 1.0
+        return cls(cp_inv=cp, eps_p=np.zeros(n))
+
+    def copy(self) -> PlasticState:
+        return PlasticState(self.cp_inv.copy(), self.eps_p.copy(), self.dissipation)
+
+
+# --------------------------------------------------------------------------- 2×2 tensor functions
+def _atanh_sqrt_over_sqrt(x):
+    """G(x) = atanh(√x)/√x = Σ x^k/(2k+1), analytic for |x| < 1."""
+    small = np.abs(x) < _SMALL
+    xs = np.where(small, 0.5, x)
+    r = np.sqrt(xs)
+    full = np.arctanh(r) / r
+    series = 1 + x * (1 / 3 + x * (1 / 5 + x * (1 / 7 + x * (1 / 9 + x * (1 / 11 + x / 13)))))
+    return np.where(small, series, full)
+
+
+def _sinhc_cosh(D):
+    """(sinh(√D)/√D, cosh(√D)), entire functions of D."""
+    small = np.abs(D) < _SMALL
+    Ds = np.where(small, 1.0, D)
+    y = np.sqrt(Ds)
+    sinhc = np.where(small, 1 + D * (1 / 6 + D * (1 / 120 + D * (1 / 5040 + D / 362880))),
+                     np.sinh(y) / y)
+    cosh = np.where(small, 1 + D * (1 / 2 + D * (1 / 24 + D * (1 / 720 + D / 40320))), np.cosh(y))
+    return sinhc, cosh
+
+
+def log_sym2(b11, b12, b22):
+    """Principal logarithm of a symmetric positive-definite 2×2 tensor: ln B = α I + β B."""
+    m = 0.5 * (b11 + b22)
+    D = (0.5 * (b11 - b22)) ** 2 + b12**2
+    beta = _atanh_sqrt_over_sqrt(D / m**2) / m
+    alpha = 0.5 * np.log(b11 * b22 - b12**2) - beta * m
+    return alpha + beta * b11, beta * b12, alpha + beta * b22
+
+
+def exp_sym2(e11, e12, e22):
+    """Exponential of a symmetric 2×2 tensor: exp E = α I + β E."""
+    m = 0.5 * (e11 + e22)
+    D = (0.5 * (e11 - e22)) ** 2 + e12**2
+    sinhc, cosh = _sinhc_cosh(D)
+    em = np.exp(m)
+    beta = em * sinhc
+    alpha = em * cosh - beta * m
+    return alpha + beta * e11, beta * e12, alpha + beta * e22
+
+
+# --------------------------------------------------------------------------- return mapping
+def solve_plastic_multiplier(q_tr, eps_p_n, material: Material, mu: float, tol=1e-12, maxit=60):
+    """Δγ ≥ 0 with q_tr − 3μΔγ − σ_f(ε_p,n + Δγ) = 0, vectorised (bracketed Newton).
+
+    The residual is strictly decreasing in Δγ; the root lies in [0, q_tr/(3μ)].
+    """
+    q_tr = np.asarray(q_tr, dtype=float)
+    lo = np.zeros_like(q_tr)
+    hi = q_tr / (3.0 * mu)
+    if not material.is_tabulated and material.K == 0.0:
+        return (q_tr - material.sigma_y) / (3.0 * mu)  # perfectly plastic: closed form
+    x = np.zeros_like(q_tr)
+    scale = material.sigma_y
+    for _ in range(maxit):
+        r = q_tr - 3.0 * mu * x - material.flow_stress(eps_p_n + x)
+        done = np.abs(r) <= tol * scale
+        if np.all(done):
+            break
+        lo = np.where(r > 0, x, lo)
+        hi = np.where(r < 0, x, hi)
+        slope = 3.0 * mu + material.flow_slope(eps_p_n + x)
+        x_new = x + r / slope
+        bisect = (x_new <= lo) | (x_new >= hi)
+        x = np.where(done, x, np.where(bisect, 0.5 * (lo + hi), x_new))
+    else:
+        raise RuntimeError("return mapping: plastic multiplier did not converge")
+    return x
+
+
+@dataclass
+class StressUpdate:
+    """Result of one constitutive evaluation (arrays over the points)."""
+
+    P: np.ndarray  # (5, ...) first Piola–Kirchhoff stress
+    cp_inv: np.ndarray  # (4, ...) updated C_p⁻¹
+    eps_p: np.ndarray  # (...) updated equivalent plastic strain
+    dgamma: np.ndarray  # (...) plastic multiplier increment
+    psi: np.ndarray  # (...) stored elastic energy per reference volume
+    tau: np.ndarray  # (4, ...) Kirchhoff stress rr, rz, zz, θθ
+
+
+def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None) -> StressUpdate:
+    """Exponential-map return mapping at deformation gradient ``F`` (real or complex).
+
+    ``dgamma``: the real plastic multiplier from a real call; with complex F it
+    is completed to first order in the imaginary perturbation (one Newton step
+    from the real root gives the exact complex-step derivative).
+    """
+    mu = material.shear_modulus
+    kappa = material.bulk_modulus
+    a, b, c, d, ftt = F
+    p, q, s, ctt = state_cp_inv
+    # trial elastic left Cauchy–Green tensor b_e^tr = F C_p⁻¹ Fᵀ
+    m11 = a * p + b * q
+    m12 = a * q + b * s
+    m21 = c * p + d * q
+    m22 = c * q + d * s
+    b11 = m11 * a + m12 * b
+    b12 = m11 * c + m12 * d
+    b22 = m21 * c + m22 * d
+    btt = ftt * ftt * ctt
+    e11, e12, e22 = log_sym2(b11, b12, b22)
+    e11, e12, e22 = 0.5 * e11, 0.5 * e12, 0.5 * e22
+    ett = 0.5 * np.log(btt)
+    ev = e11 + e22 + ett
+    s11 = 2 * mu * (e11 - ev / 3)
+    s22 = 2 * mu * (e22 - ev / 3)
+    stt = 2 * mu * (ett - ev / 3)
+    s12 = 2 * mu * e12
+    q_tr = np.sqrt(1.5 * (s11**2 + s22**2 + stt**2 + 2 * s12**2))
+    q_real = np.real(q_tr)
+    if dgamma is None:
+        if np.iscomplexobj(F):
+            raise ValueError("complex F needs the real plastic multiplier dgamma")
+        dgamma = np.zeros_like(q_real)
+        if np.isfinite(material.sigma_y):
+            f_tr = q_real - material.flow_stress(state_eps_p)
+            plastic = f_tr > 0.0
+            if np.any(plastic):
+                dgamma[plastic] = solve_plastic_multiplier(
+                    q_real[plastic], state_eps_p[plastic], material, mu)
+    plastic = dgamma > 0.0
+    if np.iscomplexobj(q_tr):
+        slope = material.flow_slope(state_eps_p + dgamma) if np.isfinite(material.sigma_y) else 0.0
+        dg = dgamma + np.where(plastic, (q_tr - q_real) / (3 * mu + slope), 0.0)
+    else:
+        dg = dgamma
+    q_safe = np.where(plastic, q_tr, 1.0)
+    factor = np.where(plastic, 1.0 - 3 * mu * dg / q_safe, 1.0)
+    s11, s22, stt, s12 = factor * s11, factor * s22, factor * stt, factor * s12
+    pk = kappa * ev
+    t11, t22, ttt, t12 = pk + s11, pk + s22, pk + stt, s12
+    # elastic log strain after return; b_e = exp(2 ε_e); C_p⁻¹ = F⁻¹ b_e F⁻ᵀ
+    ee11 = ev / 3 + s11 / (2 * mu)
+    ee22 = ev / 3 + s22 / (2 * mu)
+    eett = ev / 3 + stt / (2 * mu)
+    ee12 = s12 / (2 * mu)
+    n11, n12, n22 = exp_sym2(2 * ee11, 2 * ee12, 2 * ee22)
+    ntt = np.exp(2 * eett)
+    det = a * d - b * c
+    i11, i12, i21, i22 = d / det, -b / det, -c / det, a / det  # F⁻¹
+    k11 = i11 * n11 + i12 * n12
+    k12 = i11 * n12 + i12 * n22
+    k21 = i21 * n11 + i22 * n12
+    k22 = i21 * n12 + i22 * n22
+    cp_new = np.stack([k11 * i11 + k12 * i12, k11 * i21 + k12 * i22,
+                       k21 * i21 + k22 * i22, ntt / (ftt * ftt)])
+    # P = τ F⁻ᵀ, F⁻ᵀ = [[i11, i21], [i12, i22]]
+    P = np.stack([t11 * i11 + t12 * i12, t11 * i21 + t12 * i22,
+                  t12 * i11 + t22 * i12, t12 * i21 + t22 * i22, ttt / ftt])
+    psi = (s11**2 + s22**2 + stt**2 + 2 * s12**2) / (4 * mu) + 0.5 * kappa * ev**2
+    return StressUpdate(P=P, cp_inv=cp_new, eps_p=state_eps_p + dg, dgamma=dg, psi=psi,
+                        tau=np.stack([t11, t12, t22, ttt]))
+
+
+def stress_and_tangent(F, state: PlasticState, material: Material):
+    """Stress update at real F (shape (5, N)) and the tangent A[i, k] = ∂P_i/∂F_k, (5, 5, N)."""
+    real = stress_update(F, state.cp_inv, state.eps_p, material)
+    Fc = F[:, None, :] + 1j * CSTEP * np.eye(5)[:, :, None]
+    cplx = stress_update(Fc, state.cp_inv[:, None, :], state.eps_p[None, :], material,
+                         dgamma=real.dgamma[None, :])
+    A = np.imag(cplx.P) / CSTEP
+    return real, A

@@ -1,0 +1,348 @@
+"""Incremental Newton solver: one elastic–plastic hemisphere pressed on a rigid obstacle.
+
+Scene (DESIGN §4): the meridian section of a hemisphere of radius R (pole at
+the origin, equatorial plane z = R); the equatorial plane is moved towards the
+obstacle by h (u_z = −h, free to slide radially), the axis has u_r = 0, the arc
+meets a rigid flat or rigid sphere in frictionless contact (``contact.py``).
+
+Each increment: secant predictor, then Newton on the free dofs with the exact
+tangent (material ∂P/∂F by complex step, plus the rigid sphere's curvature
+term), the contact active set updated in the same loop (primal–dual active
+set: release on tensile reaction, close on penetration). Increments grow after
+easy steps and are cut back on divergence; below ``dh_min`` the run stops with
+the converged part kept and flagged.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..model.material import Material
+from .assembly import Discretisation
+from .contact import RigidObstacle, contact_edge, surface_areas
+from .mesh import build_mesh
+from .plasticity import PlasticState, stress_and_tangent
+
+
+class IncrementFailed(RuntimeError):
+    """Newton did not converge in one increment (the increment is retried smaller)."""
+
+
+@dataclass
+class SolverOptions:
+    """Increment and Newton controls; lengths in units of the sphere radius R."""
+
+    dh_first: float = 2e-4
+    dh_max: float = 0.01
+    dh_min: float = 1e-7
+    growth: float = 1.5
+    easy_iterations: int = 5  # grow the increment after at most this many iterations
+    max_iterations: int = 20
+    tol: float = 1e-8  # ‖free residual‖∞ ≤ tol · largest reaction
+
+    def validate(self) -> None:
+        for name in ("dh_first", "dh_max", "dh_min", "tol"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        if self.dh_min > self.dh_first or self.dh_first > self.dh_max:
+            raise ValueError("increments must satisfy dh_min <= dh_first <= dh_max")
+        if not self.growth >= 1.0:
+            raise ValueError(f"growth must be >= 1, got {self.growth!r}")
+        if not (isinstance(self.max_iterations, int) and 2 <= self.max_iterations <= 200):
+            raise ValueError(f"max_iterations must be an integer in [2, 200], got {self.max_iterations!r}")
+
+
+@dataclass
+class History:
+    """Per converged increment records (lists; ``as_arrays`` packs them)."""
+
+    h: list = field(default_factory=list)
+    F: list = field(default_factory=list)
+    F_support: list = field(default_factory=list)
+    a: list = field(default_factory=list)
+    a_nodes: list = field(default_factory=list)
+    a_ref: list = field(default_factory=list)
+    p_m: list = field(default_factory=list)
+    eps_p_max: list = field(default_factory=list)
+    work_external: list = field(default_factory=list)
+    energy_elastic: list = field(default_factory=list)
+    dissipation: list = field(default_factory=list)
+    iterations: list = field(default_factory=list)
+    active_changes: list = field(default_factory=list)
+    residuals: list = field(default_factory=list)
+    profile_r: list = field(default_factory=list)
+    profile_p: list = field(default_factory=list)
+    profile_g: list = field(default_factory=list)
+
+
+@dataclass
+class RunResult:
+    """Outcome of one run: curves per converged increment, status, timings, final state."""
+
+    inputs: dict
+    curves: dict
+    residuals: list
+    profile_r: np.ndarray
+    profile_p: np.ndarray
+    profile_g: np.ndarray
+    status: str  # "converged" (reached h_max) or "stopped"
+    reason: str
+    timings: dict
+    final: dict  # final deformed mesh and fields
+
+    @property
+    def h(self):
+        return self.curves["h"]
+
+    @property
+    def F(self):
+        return self.curves["F"]
+
+    @property
+    def a(self):
+        return self.curves["a"]
+
+
+class IndentationSolver:
+    """Hemisphere (radius R, material) on a rigid obstacle; call ``run(h_max)``."""
+
+    def __init__(self, material: Material, radius: float = 1.0, obstacle: RigidObstacle | None = None,
+                 density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None):
+        if material.is_rigid:
+            raise ValueError("the deformable body must not be rigid (E = inf)")
+        self.material = material
+        self.radius = float(radius)
+        self.obstacle = obstacle or RigidObstacle()
+        self.options = options or SolverOptions()
+        self.options.validate()
+        t0 = time.perf_counter()
+        self.hmesh = build_mesh(self.radius, density, linear=(element == "q4"))
+        self.disc = Discretisation(self.hmesh, element)
+        self.t_setup = time.perf_counter() - t0
+        hm, nd = self.hmesh, self.disc.n_dofs
+        self.arc = hm.surface  # ordered from the pole; the last node is the equator corner
+        self.surface = self.arc[:-1]  # contact candidates
+        self.X = hm.X
+        self.on_axis = np.isin(self.surface, hm.axis)
+        self.fixed_base = np.concatenate([2 * hm.equator + 1, 2 * hm.axis])  # u_z equator, u_r axis
+        self.n_points = self.disc.n_elements * self.disc.n_qp
+        self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+        self._nd = nd
+
+    # ------------------------------------------------------------------ one Newton solve
+    def _frame(self, active: np.ndarray, normal: np.ndarray):
+        """Nodal rotation T (u = T ũ) for active off-axis nodes on a curved obstacle,
+        and the constrained local dofs carrying the contact condition."""
+        nodes = self.surface[active]
+        if self.obstacle.is_flat:
+            return None, 2 * nodes + 1
+        rot = active & ~self.on_axis
+        rn = self.surface[rot]
+        n_r, n_z = normal[:, rot]
+        nd = self._nd
+        # u = n ũ_n + t ũ_t with t = (n_z, −n_r): local dof 2i ↔ ũ_n, 2i+1 ↔ ũ_t
+        diag = np.ones(nd)
+        diag[2 * rn] = n_r
+        diag[2 * rn + 1] = -n_r
+        rows = np.concatenate([np.arange(nd), 2 * rn, 2 * rn + 1])
+        cols = np.concatenate([np.arange(nd), 2 * rn + 1, 2 * rn])
+        vals = np.concatenate([diag, n_z, n_z])
+        T = sp.csr_matrix((vals, (rows, cols)), shape=(nd, nd))
+        on_axis_nodes = self.surface[active & self.on_axis]
+        cdofs = np.concatenate([2 * rn, 2 * on_axis_nodes + 1])
+        return T, cdofs
+
+    def _newton(self, u: np.ndarray, h: float, state: PlasticState, active: np.ndarray):
+        opt = self.options
+        disc, mat = self.disc, self.material
+        R = self.radius
+        Xs = self.X[:, self.surface]
+        res_hist = []
+        seen = set()
+        changes = 0
+        frozen = False
+        for it in range(opt.max_iterations):
+            t0 = time.perf_counter()
+            Fv = disc.deformation_gradient(u)
+            if np.any(Fv[0] * Fv[3] - Fv[1] * Fv[2] <= 0) or np.any(Fv[4] <= 0):
+                raise IncrementFailed("inverted element (J <= 0)")
+            upd, A = stress_and_tangent(Fv, state, mat)
+            t1 = time.perf_counter()
+            f = disc.internal_force(upd.P)
+            K = disc.tangent(A)
+            t2 = time.perf_counter()
+            us = np.stack([u[2 * self.surface], u[2 * self.surface + 1]])
+            gap, normal, curv = self.obstacle.gap_normal(Xs + us)
+            fs = np.stack([f[2 * self.surface], f[2 * self.surface + 1]])
+            lam = np.einsum("ci,ci->i", fs, normal)
+            if not frozen:
+                new_active = np.where(active, lam > 0.0, gap < -1e-12 * R)
+                key = new_active.tobytes()
+                if not np.array_equal(new_active, active):
+                    changes += 1
+                    if key in seen:  # cycling between sets at the contact edge: keep the larger
+                        new_active = new_active | active
+                        frozen = True
+                    seen.add(key)
+                changed = not np.array_equal(new_active, active)
+                active = new_active
+            else:
+                changed = False
+            T, cdofs = self._frame(active, normal)
+            if not self.obstacle.is_flat:
+                idx = np.flatnonzero(active & ~self.on_axis)
+                nodes = self.surface[idx]
+                k = lam[idx] * curv[idx]
+                n = normal[:, idx]
+                tt = np.stack([n[1], -n[0]])
+                blk = [(0, 0, tt[0] * tt[0]), (0, 1, tt[0] * tt[1]), (1, 0, tt[1] * tt[0]),
+                       (1, 1, tt[1] * tt[1])]
+                rows = np.concatenate([2 * nodes + i for i, _, _ in blk])
+                cols = np.concatenate([2 * nodes + j for _, j, _ in blk])
+                vals = np.concatenate([-k * v for _, _, v in blk])
+                K = K + sp.csr_matrix((vals, (rows, cols)), shape=K.shape)
+                K = (T.T @ K @ T).tocsr()
+                r = T.T @ f
+            else:
+                r = f
+            fixed = np.concatenate([self.fixed_base, cdofs])
+            free = np.ones(self._nd, dtype=bool)
+            free[fixed] = False
+            du_c = np.zeros(self._nd)
+            du_c[cdofs] = -gap[active] if self.obstacle.is_flat else np.concatenate(
+                [-gap[active & ~self.on_axis], -gap[active & self.on_axis]])
+            ref = max(np.abs(r[fixed]).max(), 1e-300)
+            res = float(np.abs(r[free]).max()) / ref
+            res_hist.append(res)
+            t3 = time.perf_counter()
+            self.timers["constitutive"] += t1 - t0
+            self.timers["assembly"] += t2 - t1
+            self.timers["contact"] += t3 - t2
+            if not np.isfinite(res) or res > 1e6:
+                raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
+            if not changed and res <= opt.tol and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
+                return u, upd, active, it, changes, res_hist, f, gap
+            Kff = K[free][:, free]
+            rhs = -r[free] - K[free][:, ~free] @ du_c[~free]
+            lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A",
+                           options={"SymmetricMode": True})
+            du = du_c.copy()
+            du[free] = lu.solve(rhs)
+            if T is not None:
+                du = T @ du
+            u = u + du
+            self.timers["solve"] += time.perf_counter() - t3
+        raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
+                              f"(last relative residual {res_hist[-1]:.2e})")
+
+    # ------------------------------------------------------------------ the incremental run
+    def run(self, h_max: float, progress=None) -> RunResult:
+        """Press the hemisphere to approach ``h_max``; ``progress(h)`` is called per increment."""
+        R = self.radius
+        h_max = float(h_max)
+        if not (np.isfinite(h_max) and 0 < h_max <= 0.8 * R):
+            raise ValueError(f"h_max must lie in (0, 0.8 R] = (0, {0.8 * R:g}], got {h_max!r}")
+        opt = self.options
+        t_start = time.perf_counter()
+        for k in self.timers:
+            self.timers[k] = 0.0
+        nd = self._nd
+        u = np.zeros(nd)
+        u_prev = None
+        state = PlasticState.virgin(self.n_points)
+        active = np.zeros(self.surface.size, dtype=bool)
+        hist = History()
+        h, dh, dh_prev = 0.0, opt.dh_first * R, None
+        status, reason = "converged", "reached h_max"
+        work = 0.0
+        F_last = 0.0
+        while h < h_max * (1 - 1e-12):
+            dh = min(dh, h_max - h, opt.dh_max * R)
+            h_new = h + dh
+            if u_prev is None:
+                u_pred = u.copy()
+                u_pred[1::2] -= dh  # rigid translation towards the obstacle
+            else:
+                u_pred = u + (dh / dh_prev) * (u - u_prev)
+            u_pred[2 * self.hmesh.equator + 1] = -h_new
+            u_pred[2 * self.hmesh.axis] = 0.0
+            try:
+                u_new, upd, act, its, changes, res_hist, f, gap = self._newton(
+                    u_pred, h_new, state, active.copy())
+            except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
+                dh *= 0.5
+                if dh < opt.dh_min * R:
+                    status = "stopped"
+                    reason = (f"increment below dh_min = {opt.dh_min:g} R at h/R = {h / R:.6g}: {err}")
+                    break
+                continue
+            # ---- commit
+            eps_p_n = state.eps_p
+            dgamma = upd.dgamma
+            diss_inc = self.disc.integrate(
+                np.where(dgamma > 0, self.material.flow_stress(eps_p_n + dgamma) * dgamma, 0.0)
+                if np.isfinite(self.material.sigma_y) else np.zeros_like(dgamma))
+            state = PlasticState(upd.cp_inv, upd.eps_p, state.dissipation + diss_inc)
+            u_prev, u, dh_prev, active = u, u_new, dh, act
+            h = h_new
+            F_support = -float(f[2 * self.hmesh.equator + 1].sum())
+            xs = self.X[:, self.surface] + np.stack([u[2 * self.surface], u[2 * self.surface + 1]])
+            _, normal, _ = self.obstacle.gap_normal(xs)
+            lam = np.where(active, np.einsum("ci,ci->i", np.stack(
+                [f[2 * self.surface], f[2 * self.surface + 1]]), normal), 0.0)
+            F = float(np.sum(lam * normal[1]))
+            xa = self.X[:, self.arc] + np.stack([u[2 * self.arc], u[2 * self.arc + 1]])
+            areas = surface_areas(xa)[:-1]
+            pressure = np.where(active, lam / areas, 0.0)
+            a_nodes, a_sub, a_ref = contact_edge(self.X[0, self.surface], xs[0], gap, active)
+            work += 0.5 * (F + F_last) * dh
+            F_last = F
+            hist.h.append(h)
+            hist.F.append(F)
+            hist.F_support.append(F_support)
+            hist.a.append(a_sub)
+            hist.a_nodes.append(a_nodes)
+            hist.a_ref.append(a_ref)
+            hist.p_m.append(F / (np.pi * a_sub**2) if a_sub > 0 else 0.0)
+            hist.eps_p_max.append(float(state.eps_p.max()))
+            hist.work_external.append(work)
+            hist.energy_elastic.append(self.disc.integrate(upd.psi))
+            hist.dissipation.append(state.dissipation)
+            hist.iterations.append(its)
+            hist.active_changes.append(changes)
+            hist.residuals.append(res_hist)
+            hist.profile_r.append(xs[0].copy())
+            hist.profile_p.append(pressure)
+            hist.profile_g.append(np.where(active, 0.0, gap))
+            if progress is not None:
+                progress(h)
+            if its <= opt.easy_iterations:
+                dh *= opt.growth
+        wall = time.perf_counter() - t_start
+        curves = {k: np.asarray(getattr(hist, k), dtype=float) for k in (
+            "h", "F", "F_support", "a", "a_nodes", "a_ref", "p_m", "eps_p_max", "work_external",
+            "energy_elastic", "dissipation", "iterations", "active_changes")}
+        curves["iterations"] = curves["iterations"].astype(int)
+        curves["active_changes"] = curves["active_changes"].astype(int)
+        nsurf = self.surface.size
+        prof_r = np.array(hist.profile_r).reshape(-1, nsurf)
+        prof_p = np.array(hist.profile_p).reshape(-1, nsurf)
+        prof_g = np.array(hist.profile_g).reshape(-1, nsurf)
+        timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
+                   "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum())}
+        final = {"X": self.X, "u": u, "cells": self.disc.basis.element_dofs.T.copy(),
+                 "eps_p": state.eps_p.reshape(self.disc.n_elements, self.disc.n_qp)}
+        inputs = {"material": self.material.describe(), "radius": R,
+                  "indenter_radius": float(self.obstacle.radius), "h_max": h_max,
+                  "mesh_density": self.hmesh.density, "element": self.disc.element,
+                  "n_elements": self.disc.n_elements, "n_dofs": self._nd,
+                  "options": dict(vars(self.options))}
+        return RunResult(inputs=inputs, curves=curves, residuals=hist.residuals,
+                         profile_r=prof_r, profile_p=prof_p, profile_g=prof_g, status=status, reason=reason,
+                         timings=timings, final=final)

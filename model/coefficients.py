@@ -1,0 +1,348 @@
+"""Coefficient set of the level functions H̄(Λ), c²(Λ) (DESIGN §2), stored as versioned JSON.
+
+The set is read from ``data/coefficients.json`` (the ``SPHERECONTACT_COEFFICIENTS``
+environment variable names another file). If the shipped file is missing, the
+built-in literature set :data:`LITERATURE` (identical to the shipped file) is used.
+The JSON schema is documented in ``model/README.md``; calibration writes new
+values into the same schema with ``"source": "calibration"``.
+
+Functional forms fixed by the schema (symbols of DESIGN §1–2):
+
+* Level III, hardening exponent n:  q_III(n) = prefactor · exp(Σ_k exp_poly[k] n^(k+1))
+  for q = H̄, c²;
+* Level II, t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) ∈ [0, 1]:
+  q(t) = q_I + (q_III − q_I) · [t + t(1 − t) Σ_k shape[k] t^k]  (continuous at both ends);
+* finite size, geometric ratio x (a/ρ_i or a/R_i):  q → q · (1 + Σ_k coeffs[k] x^(k+1)),
+  which vanishes as x → 0.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "LITERATURE",
+    "Coefficients",
+    "default_path",
+    "load_coefficients",
+    "default_coefficients",
+]
+
+SCHEMA_VERSION = 1
+ENV_VAR = "SPHERECONTACT_COEFFICIENTS"
+SOURCES = ("literature", "calibration")
+RATIOS = ("a_over_rho", "a_over_R")
+EXPONENT_METHODS = ("secant_loglog",)
+
+#: Built-in literature set; identical to the shipped ``data/coefficients.json``.
+LITERATURE: dict = {
+    "schema_version": 1,
+    "source": "literature",
+    "provenance": {
+        "created": "2025-11-21",
+        "method": "literature starting values, no fit to FE data",
+        "fe_dataset": None,
+        "notes": (
+            "Level I is exact Hertz. Level III and beta from the Brinell similarity analyses; "
+            "Level II is the straight line in ln(Lambda) joining Level I and Level III (no shape "
+            "terms); no finite-size terms. These are starting values for calibration, not results."
+        ),
+    },
+    "beta": 0.32,
+    "Lambda_I": 3.0,
+    "Lambda_III": 40.0,
+    "H_bar_III": {"prefactor": 3.07, "exp_poly": []},
+    "c2_III": {"prefactor": 1.43, "exp_poly": [-0.97]},
+    "level_II": {"H_bar_shape": [], "c2_shape": []},
+    "hardening_exponent": {"method": "secant_loglog", "eps_lo": 0.01, "eps_hi": 0.1},
+    "finite_size": {"ratio": "a_over_rho", "H_bar": [], "c2": []},
+    "references": {
+        "beta": (
+            "Biwa & Storakers (1995) J. Mech. Phys. Solids 43:1303, fully plastic Brinell "
+            "similarity solution: H = 3.07 sigma(eps_rep = 0.32 a/R) (seed eq. 3). Tabor (1951) "
+            "The Hardness of Metals: beta = 0.2 with H_bar = 2.8 (seed eq. 2)."
+        ),
+        "Lambda_I": (
+            "Johnson (1985) Contact Mechanics, sec. 6.3-6.5; seed sec. 2: Level I (elastic) "
+            "for Lambda < 3."
+        ),
+        "Lambda_III": (
+            "Johnson (1985) Contact Mechanics, sec. 6.5: fully plastic indentation for "
+            "E* a/(Y R) of about 40; the straight line in ln(Lambda) from (3, 4/pi) to "
+            "(40, 3.07) has slope 0.69, close to the 2/3 of Johnson's cavity model."
+        ),
+        "H_bar_III": (
+            "Biwa & Storakers (1995): H_bar = 3.07 with beta = 0.32, independent of the "
+            "hardening exponent (seed eq. 3)."
+        ),
+        "c2_III": (
+            "Storakers, Biwa & Larsson (1997) Int. J. Solids Struct. 34:3061, fit of the "
+            "similarity solutions for sigma = sigma_0 eps^(1/m): c^2 = 1.43 exp(-0.97/m); "
+            "written here with n = 1/m. Limits: n = 0 (perfectly plastic) 1.43; n = 1 gives "
+            "0.54, near the Hertz value 1/2."
+        ),
+        "level_II": (
+            "Seed sec. 2 and Fig. 2: H_bar and c^2 approximately linear in ln(Lambda) in "
+            "Level II."
+        ),
+        "hardening_exponent": (
+            "Mapping of a general flow curve to the power-law exponent n of the similarity "
+            "solutions: secant slope of ln(sigma_f) against ln(eps_p) between eps_lo and eps_hi "
+            "(the decade of eps_rep = beta a/rho met in Level III). Exact for sigma_f = K eps^n; "
+            "0 for perfect plasticity."
+        ),
+        "finite_size": (
+            "DESIGN sec. 2: finite-size and large-deformation terms vanish as a/rho -> 0; none "
+            "in the literature set (pure half-space theory)."
+        ),
+    },
+}
+
+
+def _number(d: dict, key: str, where: str) -> float:
+    if key not in d:
+        raise ValueError(f"coefficients: missing key '{where}{key}'")
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, int | float):
+        raise ValueError(f"coefficients: '{where}{key}' must be a number, got {type(v).__name__}")
+    v = float(v)
+    if not math.isfinite(v):
+        raise ValueError(f"coefficients: '{where}{key}' must be finite, got {v!r}")
+    return v
+
+
+def _poly(d: dict, key: str, where: str) -> tuple[float, ...]:
+    if key not in d:
+        raise ValueError(f"coefficients: missing key '{where}{key}'")
+    v = d[key]
+    if not isinstance(v, list | tuple):
+        raise ValueError(
+            f"coefficients: '{where}{key}' must be a list of numbers (1-D), got {type(v).__name__}"
+        )
+    out = []
+    for i, c in enumerate(v):
+        if isinstance(c, bool) or not isinstance(c, int | float) or not math.isfinite(c):
+            raise ValueError(f"coefficients: '{where}{key}[{i}]' must be a finite number, got {c!r}")
+        out.append(float(c))
+    return tuple(out)
+
+
+def _section(d: dict, key: str) -> dict:
+    if key not in d:
+        raise ValueError(f"coefficients: missing key '{key}'")
+    v = d[key]
+    if not isinstance(v, dict):
+        raise ValueError(f"coefficients: '{key}' must be an object, got {type(v).__name__}")
+    return v
+
+
+def _choice(d: dict, key: str, where: str, allowed: tuple[str, ...]) -> str:
+    if key not in d:
+        raise ValueError(f"coefficients: missing key '{where}{key}'")
+    v = d[key]
+    if v not in allowed:
+        raise ValueError(f"coefficients: '{where}{key}' must be one of {allowed}, got {v!r}")
+    return v
+
+
+def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
+    """prefactor · exp(Σ_k c_k n^(k+1)), vectorised in n."""
+    n = np.asarray(n, dtype=float)
+    s = np.zeros_like(n)
+    for c in reversed(exp_poly):
+        s = (s + c) * n
+    return prefactor * np.exp(s)
+
+
+@dataclass(frozen=True)
+class Coefficients:
+    """A validated coefficient set (see module docstring for the functional forms)."""
+
+    beta: float
+    Lambda_I: float
+    Lambda_III: float
+    H_bar_III_prefactor: float
+    H_bar_III_exp_poly: tuple[float, ...]
+    c2_III_prefactor: float
+    c2_III_exp_poly: tuple[float, ...]
+    H_bar_shape: tuple[float, ...]
+    c2_shape: tuple[float, ...]
+    exponent_method: str
+    eps_lo: float
+    eps_hi: float
+    finite_size_ratio: str
+    finite_size_H_bar: tuple[float, ...]
+    finite_size_c2: tuple[float, ...]
+    source: str = "literature"
+    schema_version: int = SCHEMA_VERSION
+    provenance: dict = field(default_factory=dict, compare=False, hash=False, repr=False)
+    references: dict = field(default_factory=dict, compare=False, hash=False, repr=False)
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_dict(cls, d: dict) -> Coefficients:
+        """Validate a schema-v1 dictionary; ValueError names the offending key."""
+        if not isinstance(d, dict):
+            raise ValueError(f"coefficients: top level must be an object, got {type(d).__name__}")
+        if "schema_version" not in d:
+            raise ValueError("coefficients: missing key 'schema_version'")
+        if d["schema_version"] != SCHEMA_VERSION or isinstance(d["schema_version"], bool):
+            raise ValueError(
+                f"coefficients: unknown 'schema_version' {d['schema_version']!r} "
+                f"(this version reads schema_version = {SCHEMA_VERSION})"
+            )
+        source = _choice(d, "source", "", SOURCES)
+        provenance = _section(d, "provenance")
+        beta = _number(d, "beta", "")
+        if beta <= 0.0:
+            raise ValueError(f"coefficients: 'beta' must be > 0, got {beta!r}")
+        lam1 = _number(d, "Lambda_I", "")
+        lam3 = _number(d, "Lambda_III", "")
+        if not 0.0 < lam1 < lam3:
+            raise ValueError(
+                f"coefficients: need 0 < 'Lambda_I' < 'Lambda_III', got {lam1!r}, {lam3!r}"
+            )
+        H3 = _section(d, "H_bar_III")
+        c3 = _section(d, "c2_III")
+        H3p = _number(H3, "prefactor", "H_bar_III.")
+        c3p = _number(c3, "prefactor", "c2_III.")
+        if H3p <= 0.0:
+            raise ValueError(f"coefficients: 'H_bar_III.prefactor' must be > 0, got {H3p!r}")
+        if c3p <= 0.0:
+            raise ValueError(f"coefficients: 'c2_III.prefactor' must be > 0, got {c3p!r}")
+        lev2 = _section(d, "level_II")
+        hexp = _section(d, "hardening_exponent")
+        method = _choice(hexp, "method", "hardening_exponent.", EXPONENT_METHODS)
+        eps_lo = _number(hexp, "eps_lo", "hardening_exponent.")
+        eps_hi = _number(hexp, "eps_hi", "hardening_exponent.")
+        if not 0.0 < eps_lo < eps_hi:
+            raise ValueError(
+                "coefficients: need 0 < 'hardening_exponent.eps_lo' < 'hardening_exponent.eps_hi',"
+                f" got {eps_lo!r}, {eps_hi!r}"
+            )
+        fs = _section(d, "finite_size")
+        refs = d.get("references", {})
+        if not isinstance(refs, dict):
+            raise ValueError("coefficients: 'references' must be an object")
+        return cls(
+            beta=beta,
+            Lambda_I=lam1,
+            Lambda_III=lam3,
+            H_bar_III_prefactor=H3p,
+            H_bar_III_exp_poly=_poly(H3, "exp_poly", "H_bar_III."),
+            c2_III_prefactor=c3p,
+            c2_III_exp_poly=_poly(c3, "exp_poly", "c2_III."),
+            H_bar_shape=_poly(lev2, "H_bar_shape", "level_II."),
+            c2_shape=_poly(lev2, "c2_shape", "level_II."),
+            exponent_method=method,
+            eps_lo=eps_lo,
+            eps_hi=eps_hi,
+            finite_size_ratio=_choice(fs, "ratio", "finite_size.", RATIOS),
+            finite_size_H_bar=_poly(fs, "H_bar", "finite_size."),
+            finite_size_c2=_poly(fs, "c2", "finite_size."),
+            source=source,
+            schema_version=SCHEMA_VERSION,
+            provenance=copy.deepcopy(provenance),
+            references=copy.deepcopy(refs),
+        )
+
+    def to_dict(self) -> dict:
+        """The schema-v1 dictionary (round-trips through :meth:`from_dict`)."""
+        return {
+            "schema_version": self.schema_version,
+            "source": self.source,
+            "provenance": copy.deepcopy(self.provenance),
+            "beta": self.beta,
+            "Lambda_I": self.Lambda_I,
+            "Lambda_III": self.Lambda_III,
+            "H_bar_III": {"prefactor": self.H_bar_III_prefactor,
+                          "exp_poly": list(self.H_bar_III_exp_poly)},
+            "c2_III": {"prefactor": self.c2_III_prefactor, "exp_poly": list(self.c2_III_exp_poly)},
+            "level_II": {"H_bar_shape": list(self.H_bar_shape), "c2_shape": list(self.c2_shape)},
+            "hardening_exponent": {"method": self.exponent_method, "eps_lo": self.eps_lo,
+                                   "eps_hi": self.eps_hi},
+            "finite_size": {"ratio": self.finite_size_ratio, "H_bar": list(self.finite_size_H_bar),
+                            "c2": list(self.finite_size_c2)},
+            "references": copy.deepcopy(self.references),
+        }
+
+    def replace(self, **changes) -> Coefficients:
+        """A validated copy with some schema keys changed (``replace(beta=0.2)``).
+
+        Keys are top-level schema keys; nested sections are given as whole dicts,
+        e.g. ``replace(finite_size={"ratio": "a_over_rho", "H_bar": [0.5], "c2": []})``.
+        """
+        d = self.to_dict()
+        for k, v in changes.items():
+            if k not in d:
+                raise ValueError(f"coefficients: unknown key {k!r}")
+            d[k] = v
+        return Coefficients.from_dict(d)
+
+    # ------------------------------------------------------------------ Level I and III values
+    @property
+    def H_bar_I(self) -> float:
+        """H̄ at the end of Level I: 4Λ_I/(3π) (Hertz)."""
+        return 4.0 * self.Lambda_I / (3.0 * math.pi)
+
+    def H_bar_III(self, n):
+        """Level III normalised hardness H̄_III(n), n = effective hardening exponent."""
+        return _exp_poly(self.H_bar_III_prefactor, self.H_bar_III_exp_poly, n)
+
+    def c2_III(self, n):
+        """Level III contact-area parameter c²_III(n) (Storåkers et al. 1997 form)."""
+        return _exp_poly(self.c2_III_prefactor, self.c2_III_exp_poly, n)
+
+    @property
+    def has_finite_size(self) -> bool:
+        return any(self.finite_size_H_bar) or any(self.finite_size_c2)
+
+
+def default_path() -> Path:
+    """``$SPHERECONTACT_COEFFICIENTS`` if set, else ``<repo>/data/coefficients.json``."""
+    env = os.environ.get(ENV_VAR)
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[1] / "data" / "coefficients.json"
+
+
+def load_coefficients(path: str | os.PathLike | None = None) -> Coefficients:
+    """Load and validate a coefficient file.
+
+    With ``path=None`` the default location is used (:func:`default_path`); if that
+    file does not exist and no environment override is set, the built-in
+    :data:`LITERATURE` set is returned. An explicitly named file that is missing,
+    is not JSON, or fails validation raises ValueError.
+    """
+    explicit = path is not None or bool(os.environ.get(ENV_VAR))
+    p = Path(path) if path is not None else default_path()
+    if not p.exists():
+        if explicit:
+            raise ValueError(f"coefficients: file not found: {p}")
+        return Coefficients.from_dict(LITERATURE)
+    try:
+        d = json.loads(p.read_text())
+    except json.JSONDecodeError as err:
+        raise ValueError(f"coefficients: {p} is not valid JSON ({err})") from err
+    return Coefficients.from_dict(d)
+
+
+@lru_cache(maxsize=4)
+def _cached_default(path_key: str, mtime: float) -> Coefficients:
+    return load_coefficients(None)
+
+
+def default_coefficients() -> Coefficients:
+    """The default coefficient set, re-read when the file or the env override changes."""
+    p = default_path()
+    mtime = p.stat().st_mtime if p.exists() else -1.0
+    return _cached_default(str(p), mtime)

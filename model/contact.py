@@ -1,0 +1,78 @@
+"""Public entry point: ``contact(s1, s2, h)`` — force, contact radius, split and stiffness.
+
+h ≤ 0 means no contact: F = a = h1 = h2 = stiffness = 0 there (not an error).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .coefficients import Coefficients, default_coefficients
+from .sphere import Sphere
+from .unified import pair
+
+__all__ = ["ContactState", "contact", "as_approach"]
+
+
+class ContactState(NamedTuple):
+    """Contact state, every field shaped like the approach h given to :func:`contact`."""
+
+    F: np.ndarray          # contact force
+    a: np.ndarray          # contact radius
+    h1: np.ndarray         # approach taken by body 1
+    h2: np.ndarray         # approach taken by body 2
+    stiffness: np.ndarray  # dF/dh
+    p_m: np.ndarray        # mean contact pressure F/(π a²)
+    kappa: np.ndarray      # interface curvature κ
+    rho1: np.ndarray       # relative radius seen by body 1
+    rho2: np.ndarray
+
+
+def as_approach(h) -> np.ndarray:
+    """Validate an approach argument: real, finite numbers (any shape)."""
+    try:
+        arr = np.asarray(h)
+    except Exception as err:  # ragged sequences and the like
+        raise ValueError(f"h must be a real number or array of real numbers ({err})") from err
+    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.integer)
+                                   or np.issubdtype(arr.dtype, np.floating)
+                                   or arr.dtype == bool):
+        raise ValueError(f"h must be a real number or a real array, got dtype {arr.dtype}")
+    arr = arr.astype(float)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError("h must be finite (no NaN or inf)")
+    return arr
+
+
+def _shaped(x: np.ndarray):
+    return x[()] if x.ndim == 0 else x
+
+
+def contact(s1: Sphere, s2: Sphere, h, coeffs: Coefficients | None = None) -> ContactState:
+    """Unified two-sphere contact law (DESIGN §3) evaluated at mutual approaches h.
+
+    Parameters
+    ----------
+    s1, s2 : spheres (``radius=math.inf`` for a flat, ``Material.rigid()`` for a rigid body).
+    h : approach of the two centres, float or array of any shape; h ≤ 0 is no contact.
+    coeffs : coefficient set; default ``data/coefficients.json``.
+
+    Returns
+    -------
+    ContactState with F, a, h1, h2, stiffness = dF/dh, p_m, κ, ρ_1, ρ_2 shaped like h
+    (NumPy scalars for scalar h). Outside contact all fields are 0 except ρ_i (inf).
+    """
+    hh = as_approach(h)
+    p = pair(s1, s2, default_coefficients() if coeffs is None else coeffs)
+    flat = hh.reshape(-1)
+    on = flat > 0.0
+    out = {k: np.zeros(flat.shape) for k in ContactState._fields}
+    out["rho1"][:] = np.inf
+    out["rho2"][:] = np.inf
+    if np.any(on):
+        st = p.state_from_h(flat[on])
+        for k in ("F", "a", "h1", "h2", "stiffness", "p_m", "kappa", "rho1", "rho2"):
+            out[k][on] = getattr(st, k)
+    return ContactState(**{k: _shaped(v.reshape(hh.shape)) for k, v in out.items()})

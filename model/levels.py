@@ -1,0 +1,144 @@
+"""Level functions H̄(Λ) and c²(Λ) of the Brinell-type single-body relations (DESIGN §2).
+
+| level | range            | H̄                      | c²                     |
+|-------|------------------|------------------------|------------------------|
+| I     | Λ ≤ Λ_I          | 4Λ/(3π)  (Hertz)       | 1/2  (Hertz)           |
+| II    | Λ_I < Λ < Λ_III  | q_I + (q_III − q_I)·s(t) with t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) |
+| III   | Λ ≥ Λ_III        | H̄_III(n)              | c²_III(n)              |
+
+s(t) = t + t(1 − t)·Σ_k b_k t^k (b_k: ``level_II`` shape terms; none → straight line
+in ln Λ, seed §2), so H̄ and c² are continuous at Λ_I and Λ_III. All functions are pure
+and vectorised; ``n`` is the effective hardening exponent (broadcast with Λ).
+The finite-size factor 1 + Σ_k f_k x^(k+1) multiplies H̄ and c² (x = a/ρ or a/R).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .coefficients import Coefficients
+
+__all__ = [
+    "C2_HERTZ",
+    "level",
+    "H_bar",
+    "c2",
+    "H_bar_and_slope",
+    "c2_and_slope",
+    "finite_size_factor",
+    "levels_scalar_n",
+]
+
+#: Hertz contact-area parameter c² = a²/(2hR) = 1/2 (a² = R h).
+C2_HERTZ = 0.5
+_HERTZ = 4.0 / (3.0 * math.pi)
+
+
+def level(Lambda, coeffs: Coefficients) -> np.ndarray:
+    """Level index 1, 2 or 3 of Λ (Level I includes Λ_I, Level III includes Λ_III)."""
+    L = np.asarray(Lambda, dtype=float)
+    return np.where(L <= coeffs.Lambda_I, 1, np.where(L < coeffs.Lambda_III, 2, 3))
+
+
+def _shape(t, b: tuple[float, ...]):
+    """s(t) = t + t(1−t)P(t) and s'(t), P(t) = Σ b_k t^k."""
+    if not b:
+        return t, np.ones_like(t)
+    P = np.zeros_like(t)
+    dP = np.zeros_like(t)
+    for c in reversed(b):
+        dP = dP * t + P
+        P = P * t + c
+    return t + t * (1.0 - t) * P, 1.0 + (1.0 - 2.0 * t) * P + t * (1.0 - t) * dP
+
+
+def _level_II(Lambda, q_I, q_III, coeffs: Coefficients, shape):
+    """q(Λ) in Level II and d q/d ln Λ (t clipped to [0, 1])."""
+    L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
+    with np.errstate(divide="ignore"):
+        t = np.clip(np.log(Lambda / coeffs.Lambda_I) / L, 0.0, 1.0)
+    s, ds = _shape(t, shape)
+    return q_I + (q_III - q_I) * s, (q_III - q_I) * ds / L
+
+
+def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_III: float):
+    """H̄, d ln H̄/d ln Λ, c², d ln c²/d ln Λ and the level index in one pass.
+
+    Fast path for one material (Level III values H_III, c2_III given as floats);
+    same results as :func:`H_bar_and_slope` and :func:`c2_and_slope`.
+    """
+    Lam = np.asarray(Lambda, dtype=float)
+    lam1, lam3 = coeffs.Lambda_I, coeffs.Lambda_III
+    L = math.log(lam3 / lam1)
+    lev = np.where(Lam <= lam1, 1, np.where(Lam < lam3, 2, 3))
+    with np.errstate(divide="ignore"):
+        t = np.clip(np.log(Lam / lam1) / L, 0.0, 1.0)
+    H_I = coeffs.H_bar_I
+    sH_t, dsH_t = _shape(t, coeffs.H_bar_shape)
+    sc_t, dsc_t = _shape(t, coeffs.c2_shape)
+    H2 = H_I + (H_III - H_I) * sH_t
+    c2_2 = C2_HERTZ + (c2_III - C2_HERTZ) * sc_t
+    one, two = lev == 1, lev == 2
+    H = np.where(one, _HERTZ * Lam, np.where(two, H2, H_III))
+    c = np.where(one, C2_HERTZ, np.where(two, c2_2, c2_III))
+    sH = np.where(one, 1.0, np.where(two, (H_III - H_I) * dsH_t / (L * H2), 0.0))
+    sc = np.where(two, (c2_III - C2_HERTZ) * dsc_t / (L * c2_2), 0.0)
+    return H, sH, c, sc, lev
+
+
+def H_bar_and_slope(Lambda, coeffs: Coefficients, n=0.0):
+    """H̄(Λ) and its log slope d ln H̄/d ln Λ (no finite-size factor).
+
+    Level I: H̄ = 4Λ/(3π), slope 1 (Hertz: p_m = 4E'a/(3πρ)).
+    """
+    Lam, n = np.broadcast_arrays(np.asarray(Lambda, dtype=float), np.asarray(n, dtype=float))
+    H_I = coeffs.H_bar_I
+    H_III = coeffs.H_bar_III(n)
+    H2, dH2 = _level_II(Lam, H_I, H_III, coeffs, coeffs.H_bar_shape)
+    lev = level(Lam, coeffs)
+    H = np.where(lev == 1, _HERTZ * Lam, np.where(lev == 2, H2, H_III))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.where(lev == 1, 1.0, np.where(lev == 2, dH2 / H2, 0.0))
+    return H, slope
+
+
+def c2_and_slope(Lambda, coeffs: Coefficients, n=0.0):
+    """c²(Λ) and its log slope d ln c²/d ln Λ (no finite-size factor)."""
+    Lam, n = np.broadcast_arrays(np.asarray(Lambda, dtype=float), np.asarray(n, dtype=float))
+    c_III = coeffs.c2_III(n)
+    c2_II, dc2_II = _level_II(Lam, C2_HERTZ, c_III, coeffs, coeffs.c2_shape)
+    lev = level(Lam, coeffs)
+    c = np.where(lev == 1, C2_HERTZ, np.where(lev == 2, c2_II, c_III))
+    slope = np.where(lev == 2, dc2_II / c2_II, 0.0)
+    return c, slope
+
+
+def finite_size_factor(x, poly: tuple[float, ...]):
+    """Factor f(x) = 1 + Σ_k poly[k] x^(k+1) and its log slope d ln f/d ln x.
+
+    f(0) = 1 exactly: the correction vanishes as x → 0 (DESIGN §2).
+    """
+    x = np.asarray(x, dtype=float)
+    if not poly:
+        return np.ones_like(x), np.zeros_like(x)
+    s = np.zeros_like(x)   # Σ c_k x^(k+1)
+    ds = np.zeros_like(x)  # Σ (k+1) c_k x^(k+1)
+    for k in range(len(poly) - 1, -1, -1):
+        s = (s + poly[k]) * x
+        ds = (ds + (k + 1) * poly[k]) * x
+    f = 1.0 + s
+    return f, ds / f
+
+
+def H_bar(Lambda, coeffs: Coefficients, n=0.0, x=0.0):
+    """Normalised hardness H̄ = p_m/σ_rep (seed eq. 1) with the finite-size factor at x."""
+    H, _ = H_bar_and_slope(Lambda, coeffs, n)
+    return H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
+
+
+def c2(Lambda, coeffs: Coefficients, n=0.0, x=0.0):
+    """Contact-area parameter c² = a²/(2hρ) (seed eq. 5) with the finite-size factor at x."""
+    c, _ = c2_and_slope(Lambda, coeffs, n)
+    return c * finite_size_factor(x, coeffs.finite_size_c2)[0]

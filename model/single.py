@@ -1,0 +1,183 @@
+"""Single-body global relations (DESIGN §2): one body pressed by a rigid surface of relative radius ρ.
+
+With x = a/ρ (all quantities are functions of a and ρ only through x, except the
+finite-size ratio when it is a/R):
+
+    ε_rep = β x,  σ_rep = σ_f(ε_rep),  Λ = E' x/σ_rep          (seed eqs. 2–4)
+    p_m = H̄(Λ) σ_rep  (Level I: p_m = 4E'x/(3π), Hertz)          (seed eq. 1)
+    h = a²/(2c²ρ) = a x/(2c²),   F = π a² p_m                   (seed eq. 5)
+
+Log slopes used by the two-body solver and for dF/dh (m = d ln σ_f/d ln ε at ε_rep):
+
+    ∂ln p_m/∂ln x = (d ln H̄/d ln Λ)(1 − m) + m,   ∂ln c²/∂ln x = (d ln c²/d ln Λ)(1 − m).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+
+from .coefficients import Coefficients, default_coefficients
+from .levels import finite_size_factor, levels_scalar_n
+from .material import Material
+
+__all__ = [
+    "flow_log_slope",
+    "effective_exponent",
+    "BodyResponse",
+    "BodyLaw",
+    "IndentState",
+    "indent",
+]
+
+_HERTZ = 4.0 / (3.0 * math.pi)
+
+
+def flow_log_slope(material: Material, eps) -> np.ndarray:
+    """m = d ln σ_f / d ln ε_p = ε σ_f'(ε)/σ_f(ε), vectorised (0 at ε = 0 and for elastic bodies).
+
+    Ludwik: m = n K ε^n/(σ_Y + K ε^n); tables: right derivative of the interpolant.
+    """
+    e = np.maximum(np.asarray(eps, dtype=float), 0.0)
+    if material.is_rigid or math.isinf(material.sigma_y):
+        return np.zeros_like(e)
+    if material.is_tabulated:
+        return e * material.flow_slope(e) / material.flow_stress(e)
+    if material.K == 0.0 or material.n == 0.0:
+        return np.zeros_like(e)
+    t = material.K * e**material.n
+    return material.n * t / (material.sigma_y + t)
+
+
+def effective_exponent(material: Material, coeffs: Coefficients) -> float:
+    """Effective power-law hardening exponent n used in H̄_III(n), c²_III(n).
+
+    ``secant_loglog``: n = ln(σ_f(ε_hi)/σ_f(ε_lo)) / ln(ε_hi/ε_lo) — exact for
+    σ_f = K ε^n, 0 for perfect plasticity; one value per material, so Level III
+    stays self-similar (Biwa & Storåkers 1995) and F(h) stays smooth.
+    """
+    if material.is_rigid or math.isinf(material.sigma_y):
+        return 0.0
+    s_lo, s_hi = material.flow_stress(np.array([coeffs.eps_lo, coeffs.eps_hi]))
+    return float(math.log(s_hi / s_lo) / math.log(coeffs.eps_hi / coeffs.eps_lo))
+
+
+def _segment(material: Material, eps) -> np.ndarray:
+    """Index of the flow-curve piece containing ε (0 for Ludwik curves)."""
+    if not material.is_tabulated:
+        return np.zeros(np.shape(eps), dtype=np.int64)
+    et = np.asarray(material.eps_table)
+    return np.clip(np.searchsorted(et, eps, side="right") - 1, 0, et.size - 2)
+
+
+class BodyResponse(NamedTuple):
+    """Response of one body at x = a/ρ (and finite-size ratio y); arrays."""
+
+    p_m: np.ndarray        # mean contact pressure
+    c2: np.ndarray         # contact-area parameter c²
+    Lambda: np.ndarray     # Johnson's parameter Λ
+    sigma_rep: np.ndarray  # representative stress
+    dlnp_dlnx: np.ndarray  # ∂ln p_m/∂ln x
+    dlnp_dlny: np.ndarray  # ∂ln p_m/∂ln y (finite-size factor)
+    dlnc2_dlnx: np.ndarray
+    dlnc2_dlny: np.ndarray
+    piece: np.ndarray      # smooth-piece id (level and flow-table segment); kinks where it changes
+
+
+@dataclass(frozen=True)
+class BodyLaw:
+    """Single-body law p_m(x), c²(x) of one deformable material (DESIGN §2)."""
+
+    material: Material
+    coeffs: Coefficients
+    n_eff: float = field(init=False)
+    H_bar_III: float = field(init=False)
+    c2_III: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        if self.material.is_rigid:
+            raise ValueError("BodyLaw: a rigid body has no deformation law (E = inf)")
+        n = effective_exponent(self.material, self.coeffs)
+        object.__setattr__(self, "n_eff", n)
+        object.__setattr__(self, "H_bar_III", float(self.coeffs.H_bar_III(n)))
+        object.__setattr__(self, "c2_III", float(self.coeffs.c2_III(n)))
+
+    @property
+    def E_prime(self) -> float:
+        return self.material.E_prime
+
+    def response(self, x, y=None) -> BodyResponse:
+        """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ)."""
+        mat, co = self.material, self.coeffs
+        x = np.asarray(x, dtype=float)
+        y = x if y is None else np.asarray(y, dtype=float)
+        Ep = mat.E_prime
+        eps = co.beta * x
+        if math.isinf(mat.sigma_y):  # elastic: always Level I
+            sig = np.full_like(x, math.inf)
+            Lam = np.zeros_like(x)
+            m = np.zeros_like(x)
+        else:
+            sig = mat.flow_stress(eps)
+            Lam = Ep * x / sig
+            m = flow_log_slope(mat, eps)
+        H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III)
+        with np.errstate(invalid="ignore"):
+            p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
+        fH, dfH = finite_size_factor(y, co.finite_size_H_bar)
+        fc, dfc = finite_size_factor(y, co.finite_size_c2)
+        piece = lev + 3 * _segment(mat, eps)
+        return BodyResponse(
+            p_m=p * fH, c2=c * fc, Lambda=Lam, sigma_rep=sig,
+            dlnp_dlnx=sH * (1.0 - m) + m, dlnp_dlny=dfH,
+            dlnc2_dlnx=sc * (1.0 - m), dlnc2_dlny=dfc, piece=piece,
+        )
+
+
+class IndentState(NamedTuple):
+    """Single body against a rigid surface of relative radius ρ."""
+
+    a: np.ndarray
+    p_m: np.ndarray
+    F: np.ndarray
+    h: np.ndarray
+    Lambda: np.ndarray
+    H_bar: np.ndarray
+    c2: np.ndarray
+    stiffness: np.ndarray  # dF/dh
+
+
+def indent(material: Material, a, rho: float, radius: float | None = None,
+           coeffs: Coefficients | None = None) -> IndentState:
+    """Single-body relations given the contact radius a (vectorised).
+
+    Parameters
+    ----------
+    material : deformable material.
+    a : contact radius (array), > 0.
+    rho : relative radius ρ of the rigid surface seen by the body.
+    radius : body radius R (for the finite-size ratio a/R); defaults to ρ.
+    coeffs : coefficient set; default :func:`default_coefficients`.
+
+    Returns
+    -------
+    IndentState with p_m = H̄ σ_rep, h = a²/(2c²ρ), F = πa²p_m and dF/dh.
+    """
+    co = default_coefficients() if coeffs is None else coeffs
+    a = np.asarray(a, dtype=float)
+    law = BodyLaw(material, co)
+    x = a / rho
+    R = rho if radius is None else radius
+    y = x if co.finite_size_ratio == "a_over_rho" else a / R
+    r = law.response(x, y)
+    F = math.pi * a**2 * r.p_m
+    h = a * x / (2.0 * r.c2)
+    dlnF = 2.0 + r.dlnp_dlnx + r.dlnp_dlny
+    dlnh = 2.0 - r.dlnc2_dlnx - r.dlnc2_dlny
+    with np.errstate(invalid="ignore", divide="ignore"):
+        H = np.where(np.isfinite(r.sigma_rep), r.p_m / r.sigma_rep, np.nan)
+        k = F * dlnF / (h * dlnh)
+    return IndentState(a=a, p_m=r.p_m, F=F, h=h, Lambda=r.Lambda, H_bar=H, c2=r.c2, stiffness=k)

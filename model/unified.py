@@ -1,0 +1,235 @@
+"""Two dissimilar spheres — the unified model (DESIGN §3).
+
+The interface bends to a curvature κ; body i sees the relative radius ρ_i:
+
+    1/ρ_1 = 1/R_1 − κ,   1/ρ_2 = 1/R_2 + κ,   1/ρ_1 + 1/ρ_2 = 1/R*.
+
+For a given contact radius a, κ follows from equal mean pressures
+
+    p_m = H̄(Λ_1) σ_rep,1 = H̄(Λ_2) σ_rep,2,   Λ_i = E'_i a/(σ_rep,i ρ_i),
+
+and h_i = a²/(2 c_i² ρ_i), h = h_1 + h_2, F = π a² p_m. The κ root is found in the
+variable u = ln(ρ_2/ρ_1) (ρ_1/R* = 1 + e^(−u)), where g(u) = ln p_1 − ln p_2 increases
+monotonically; in Level I the root is u = ln(E'_2/E'_1) (ρ_i = E'_i R*/E*, Hertz).
+Scenes that need no κ solve: equal materials (with the finite-size ratio a/ρ or equal
+radii: ρ_1 = ρ_2 = 2R*) and a rigid partner (ρ = R* for the deformable body).
+
+The stiffness dF/dh is exact: implicit differentiation of g(u; a) = 0 gives
+du/d ln a = −(∂g/∂ln a)/(∂g/∂u), and dF/dh = (dF/d ln a)/(dh/d ln a).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from typing import NamedTuple
+
+import numpy as np
+
+from .coefficients import Coefficients, default_coefficients
+from .roots import solve_increasing
+from .single import BodyLaw, BodyResponse
+from .sphere import Sphere
+
+__all__ = ["UnifiedState", "UnifiedPair", "pair"]
+
+
+class UnifiedState(NamedTuple):
+    """State of the two-body contact at contact radius a (1-D arrays)."""
+
+    a: np.ndarray
+    kappa: np.ndarray     # interface curvature κ
+    rho1: np.ndarray      # relative radius seen by body 1 (inf: body 1 rigid)
+    rho2: np.ndarray
+    p_m: np.ndarray       # mean contact pressure
+    h1: np.ndarray        # approach taken by body 1
+    h2: np.ndarray
+    h: np.ndarray         # h = h1 + h2
+    F: np.ndarray         # contact force π a² p_m
+    stiffness: np.ndarray  # dF/dh
+    Lambda1: np.ndarray
+    Lambda2: np.ndarray
+    piece: np.ndarray     # smooth-piece id of the pair (changes at level/table kinks)
+    dlnF_dlna: np.ndarray  # d ln F/d ln a
+    dlnh_dlna: np.ndarray  # d ln h/d ln a
+    dlnh1_dlna: np.ndarray  # d ln h_1/d ln a (0 if body 1 is rigid)
+
+
+def _sigmoid(u):
+    """w = 1/(1 + e^(−u)) and 1 − w, without overflow."""
+    e = np.exp(-np.abs(u))
+    big = 1.0 / (1.0 + e)
+    small = e / (1.0 + e)
+    pos = u >= 0
+    return np.where(pos, big, small), np.where(pos, small, big)
+
+
+class UnifiedPair:
+    """The unified two-sphere model for one pair of spheres and one coefficient set.
+
+    Parameters
+    ----------
+    s1, s2 : the two spheres (a flat has radius inf; a rigid body ``Material.rigid()``).
+    coeffs : coefficient set; default :func:`default_coefficients`.
+    """
+
+    def __init__(self, s1: Sphere, s2: Sphere, coeffs: Coefficients | None = None) -> None:
+        if not isinstance(s1, Sphere) or not isinstance(s2, Sphere):
+            raise ValueError("contact needs two Sphere objects")
+        if s1.is_rigid and s2.is_rigid:
+            raise ValueError("both bodies are rigid: at least one must be deformable (finite E)")
+        if s1.is_flat and s2.is_flat:
+            raise ValueError("both bodies are flat (radius inf): at least one radius must be finite")
+        self.s1, self.s2 = s1, s2
+        self.coeffs = default_coefficients() if coeffs is None else coeffs
+        R1, R2 = s1.radius, s2.radius
+        self.R_star = 1.0 / (1.0 / R1 + 1.0 / R2)
+        self.E_star = 1.0 / (1.0 / s1.material.E_prime + 1.0 / s2.material.E_prime)
+        self.law1 = None if s1.is_rigid else BodyLaw(s1.material, self.coeffs)
+        self.law2 = None if s2.is_rigid else BodyLaw(s2.material, self.coeffs)
+        ratio_rho = self.coeffs.finite_size_ratio == "a_over_rho"
+        self._ratio_rho = ratio_rho
+        if s2.is_rigid:
+            self.mode = "rigid2"
+        elif s1.is_rigid:
+            self.mode = "rigid1"
+        elif s1.material == s2.material and (ratio_rho or R1 == R2):
+            self.mode = "equal"
+        else:
+            self.mode = "general"
+        if self.mode == "general":
+            self._u0 = math.log(s2.material.E_prime / s1.material.E_prime)
+
+    # ------------------------------------------------------------------ body responses
+    def _body(self, law: BodyLaw, a, k, R) -> BodyResponse:
+        x = a * k
+        y = x if self._ratio_rho else a / R
+        return law.response(x, y)
+
+    def _g(self, a, u):
+        """g = ln p_1 − ln p_2 at (a, u), its u-derivative, and both responses."""
+        w1, w2 = _sigmoid(u)
+        r1 = self._body(self.law1, a, w1 / self.R_star, self.s1.radius)
+        r2 = self._body(self.law2, a, w2 / self.R_star, self.s2.radius)
+        A1 = r1.dlnp_dlnx + (r1.dlnp_dlny if self._ratio_rho else 0.0)
+        A2 = r2.dlnp_dlnx + (r2.dlnp_dlny if self._ratio_rho else 0.0)
+        g = np.log(r1.p_m) - np.log(r2.p_m)
+        return g, A1 * w2 + A2 * w1, r1, r2
+
+    def solve_u(self, a, u_guess=None) -> np.ndarray:
+        """κ solve: u = ln(ρ_2/ρ_1) with equal mean pressures, for each a (1-D)."""
+        a = np.asarray(a, dtype=float)
+        u0 = np.full(a.shape, self._u0) if u_guess is None else np.asarray(u_guess, dtype=float)
+
+        def f(u, idx):
+            g, dg, _, _ = self._g(a[idx], u)
+            return g, dg
+
+        return solve_increasing(f, u0, step=1.0, tol=1e-14)
+
+    # ------------------------------------------------------------------ state given a
+    def state_at_a(self, a, u=None) -> UnifiedState:
+        """Full state for contact radii a (1-D, > 0); ``u`` skips the κ solve if given."""
+        a = np.asarray(a, dtype=float)
+        Rs = self.R_star
+        R1, R2 = self.s1.radius, self.s2.radius
+        zero = np.zeros_like(a)
+        inf = np.full_like(a, math.inf)
+        if self.mode in ("rigid1", "rigid2"):
+            law, R = (self.law1, R1) if self.mode == "rigid2" else (self.law2, R2)
+            r = self._body(law, a, 1.0 / Rs, R)
+            hb = a * a / (Rs * 2.0 * r.c2)
+            F = math.pi * a * a * r.p_m
+            dlnF = 2.0 + r.dlnp_dlnx + r.dlnp_dlny
+            dlnh = 2.0 - r.dlnc2_dlnx - r.dlnc2_dlny
+            stiff = F * dlnF / (hb * dlnh)
+            if self.mode == "rigid2":
+                kappa = np.full_like(a, -1.0 / R2)
+                return UnifiedState(a, kappa, np.full_like(a, Rs), inf, r.p_m, hb, zero, hb, F,
+                                    stiff, r.Lambda, zero, r.piece, dlnF, dlnh, dlnh)
+            kappa = np.full_like(a, 1.0 / R1)
+            return UnifiedState(a, kappa, inf, np.full_like(a, Rs), r.p_m, zero, hb, hb, F,
+                                stiff, zero, r.Lambda, r.piece, dlnF, dlnh, zero)
+
+        if self.mode == "equal":
+            u = np.zeros_like(a)
+        elif u is None:
+            u = self.solve_u(a)
+        w1, w2 = _sigmoid(u)
+        k1, k2 = w1 / Rs, w2 / Rs
+        r1 = self._body(self.law1, a, k1, R1)
+        r2 = self._body(self.law2, a, k2, R2)
+        rho = self._ratio_rho
+        # ∂/∂ln k_i at fixed a (A, Ca) and ∂/∂ln a at fixed k_i (B, Cb)
+        A1 = r1.dlnp_dlnx + (r1.dlnp_dlny if rho else 0.0)
+        A2 = r2.dlnp_dlnx + (r2.dlnp_dlny if rho else 0.0)
+        B1 = r1.dlnp_dlnx + r1.dlnp_dlny
+        B2 = r2.dlnp_dlnx + r2.dlnp_dlny
+        Ca1 = r1.dlnc2_dlnx + (r1.dlnc2_dlny if rho else 0.0)
+        Ca2 = r2.dlnc2_dlnx + (r2.dlnc2_dlny if rho else 0.0)
+        Cb1 = r1.dlnc2_dlnx + r1.dlnc2_dlny
+        Cb2 = r2.dlnc2_dlnx + r2.dlnc2_dlny
+        if self.mode == "equal":
+            du = np.zeros_like(a)
+        else:
+            den = A1 * w2 + A2 * w1
+            with np.errstate(divide="ignore", invalid="ignore"):
+                du = np.where(den > 0.0, -(B1 - B2) / den, 0.0)
+        dlnk1 = w2 * du
+        dlnk2 = -w1 * du
+        p = r1.p_m
+        dlnp = B1 + A1 * dlnk1
+        h1 = a * a * k1 / (2.0 * r1.c2)
+        h2 = a * a * k2 / (2.0 * r2.c2)
+        dlnh1 = 2.0 + (1.0 - Ca1) * dlnk1 - Cb1
+        dh = h1 * dlnh1 + h2 * (2.0 + (1.0 - Ca2) * dlnk2 - Cb2)
+        F = math.pi * a * a * p
+        h = h1 + h2
+        dlnF = 2.0 + dlnp
+        stiff = F * dlnF / dh
+        with np.errstate(divide="ignore"):
+            rho1, rho2 = 1.0 / k1, 1.0 / k2
+        kappa = 1.0 / R1 - k1
+        if self.mode == "equal":  # exact closed form, no rounding from 1/R1 − 1/(2R*)
+            kappa = np.full_like(a, 0.5 * (1.0 / R1 - 1.0 / R2))
+        return UnifiedState(a, kappa, rho1, rho2, p, h1, h2, h, F, stiff,
+                            r1.Lambda, r2.Lambda, r1.piece + 1000 * r2.piece, dlnF, dh / h, dlnh1)
+
+    # ------------------------------------------------------------------ inversion h → a
+    def _invert(self, h):
+        """Contact radius a (and the κ variable u, general mode) for approaches h > 0 (1-D)."""
+        h = np.asarray(h, dtype=float)
+        lnh = np.log(h)
+        t0 = 0.5 * (lnh + math.log(self.R_star))  # Hertz: a² = R* h
+        if self.mode != "general":
+            def f(t, idx):
+                s = self.state_at_a(np.exp(t))
+                return np.log(s.h) - lnh[idx], s.dlnh_dlna
+            return np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14)), None
+
+        u_warm = np.full(h.shape, self._u0)
+
+        def f(t, idx):
+            a = np.exp(t)
+            u = self.solve_u(a, u_warm[idx])
+            u_warm[idx] = u
+            s = self.state_at_a(a, u)
+            return np.log(s.h) - lnh[idx], s.dlnh_dlna
+
+        a = np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14))
+        return a, self.solve_u(a, u_warm)
+
+    def a_from_h(self, h) -> np.ndarray:
+        """Contact radius for approaches h (1-D, > 0): monotone root of h(a) = h in ln a."""
+        return self._invert(h)[0]
+
+    def state_from_h(self, h) -> UnifiedState:
+        """Full state for approaches h (1-D, > 0): inversion then forward evaluation."""
+        a, u = self._invert(h)
+        return self.state_at_a(a, u)
+
+
+@lru_cache(maxsize=256)
+def pair(s1: Sphere, s2: Sphere, coeffs: Coefficients | None = None) -> UnifiedPair:
+    """Cached :class:`UnifiedPair` (spheres and coefficient sets are hashable)."""
+    return UnifiedPair(s1, s2, coeffs)
