@@ -131,7 +131,9 @@ def _poly(d: dict, key: str, where: str) -> tuple[float, ...]:
     out = []
     for i, c in enumerate(v):
         if isinstance(c, bool) or not isinstance(c, int | float) or not math.isfinite(c):
-            raise ValueError(f"coefficients: '{where}{key}[{i}]' must be a finite number, got {c!r}")
+            raise ValueError(
+                f"coefficients: '{where}{key}[{i}]' must be a finite number, got {c!r}"
+            )
         out.append(float(c))
     return tuple(out)
 

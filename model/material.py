@@ -65,7 +65,9 @@ class Material:
             return  # rigid: plastic parameters are irrelevant
         sy = float(self.sigma_y)
         if math.isnan(sy) or sy <= 0.0:
-            raise ValueError(f"sigma_y (yield stress) must be > 0 (inf: elastic), got {self.sigma_y!r}")
+            raise ValueError(
+                f"sigma_y (yield stress) must be > 0 (inf: elastic), got {self.sigma_y!r}"
+            )
         if self.eps_table is None:
             K = _check_finite("K", self.K)
             n = _check_finite("n", self.n)

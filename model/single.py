@@ -1,4 +1,4 @@
-"""Single-body global relations (DESIGN §2): one body pressed by a rigid surface of relative radius ρ.
+"""Single-body global relations (DESIGN §2): one body pressed by a rigid surface of radius ρ.
 
 With x = a/ρ (all quantities are functions of a and ρ only through x, except the
 finite-size ratio when it is a/R):

@@ -1,4 +1,4 @@
-"""A sphere: radius (``math.inf`` for a flat) and material (``Material.rigid()`` for a rigid body)."""
+"""A sphere: radius (``math.inf`` for a flat) and material (``Material.rigid()`` if rigid)."""
 
 from __future__ import annotations
 

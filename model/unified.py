@@ -79,7 +79,9 @@ class UnifiedPair:
         if s1.is_rigid and s2.is_rigid:
             raise ValueError("both bodies are rigid: at least one must be deformable (finite E)")
         if s1.is_flat and s2.is_flat:
-            raise ValueError("both bodies are flat (radius inf): at least one radius must be finite")
+            raise ValueError(
+                "both bodies are flat (radius inf): at least one radius must be finite"
+            )
         self.s1, self.s2 = s1, s2
         self.coeffs = default_coefficients() if coeffs is None else coeffs
         R1, R2 = s1.radius, s2.radius
