@@ -1,0 +1,95 @@
+"""Throughput of the closed-form model: F and dF/dh for 1e6 contacts, one core.
+
+Cases: equal pair (exact, no κ solve), dissimilar pair (exact, nested κ solve),
+fast path (``ContactLaw`` table: setup time and throughput), and the explicit
+Jackson & Green (2005) formula on the same array as a cost reference.
+Approaches are log-uniform in [1e-6 R, 0.3 R]. Times are the best of ``REPEAT`` runs.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import numpy as np  # noqa: E402
+from spherecontact.model import Material, Sphere, contact  # noqa: E402
+from spherecontact.model.coefficients import default_coefficients  # noqa: E402
+from spherecontact.model.fast import ContactLaw  # noqa: E402
+from spherecontact.validation.peers import jackson_green  # noqa: E402
+
+N = 1_000_000
+REPEAT = 5
+R = 1e-3
+STEEL = Material(E=210e9, nu=0.3, sigma_y=400e6, K=600e6, n=0.3)
+ALU = Material(E=70e9, nu=0.33, sigma_y=100e6, K=200e6, n=0.5)
+
+
+def _best(fun, repeat=REPEAT) -> float:
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fun()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def main() -> dict:
+    rng = np.random.default_rng(0)
+    h = R * np.exp(rng.uniform(math.log(1e-6), math.log(0.3), N))
+    co = default_coefficients()
+    equal = (Sphere(R, STEEL), Sphere(R, STEEL))
+    dissimilar = (Sphere(R, STEEL), Sphere(2 * R, ALU))
+    out: dict = {"contacts": N, "h_range_over_R": [1e-6, 0.3],
+                 "coefficients_source": co.source, "repeat": REPEAT}
+
+    t_eq = _best(lambda: contact(*equal, h, co), 2)
+    t_dis = _best(lambda: contact(*dissimilar, h, co), 2)
+    out["exact_equal_pair"] = {"seconds": t_eq, "contacts_per_s": N / t_eq}
+    out["exact_dissimilar_pair"] = {"seconds": t_dis, "contacts_per_s": N / t_dis}
+
+    for name, pair in (("fast_equal_pair", equal), ("fast_dissimilar_pair", dissimilar)):
+        ContactLaw(*pair, coeffs=co)  # warm caches of the exact pair
+        setups = []
+        for _ in range(REPEAT):
+            t0 = time.perf_counter()
+            law = ContactLaw(*pair, coeffs=co)
+            setups.append(time.perf_counter() - t0)
+        law.force(h)
+        t_fast = _best(lambda law=law: law.force(h))
+        out[name] = {
+            "setup_s_median": float(np.median(setups)),
+            "setup_s_max": float(np.max(setups)),
+            "seconds": t_fast,
+            "contacts_per_s": N / t_fast,
+            "nodes": law.nodes,
+            "error_bound": law.error,
+        }
+
+    # Jackson & Green (2005), steel hemisphere on a rigid flat: the same h array as ω
+    Ep = STEEL.E_prime
+    jackson_green(h, R, Ep, STEEL.sigma_y, STEEL.nu)
+    t_jg = _best(lambda: jackson_green(h, R, Ep, STEEL.sigma_y, STEEL.nu))
+    wall = ContactLaw(Sphere(R, STEEL), Sphere(math.inf, Material.rigid()), coeffs=co)
+    wall.force(h)
+    t_wall = _best(lambda: wall.force(h))
+    out["jackson_green_2005_formula"] = {"seconds": t_jg, "contacts_per_s": N / t_jg}
+    out["fast_rigid_flat"] = {"seconds": t_wall, "contacts_per_s": N / t_wall,
+                              "setup_s": wall.setup_time}
+    out["cost_relative_to_jackson_green"] = {
+        "fast_rigid_flat": t_wall / t_jg,
+        "fast_dissimilar_pair": out["fast_dissimilar_pair"]["seconds"] / t_jg,
+        "exact_equal_pair": t_eq / t_jg,
+        "exact_dissimilar_pair": t_dis / t_jg,
+    }
+    out["target"] = {"fast_contacts_per_s": 1e7, "setup_s": 0.05}
+    return out
+
+
+if __name__ == "__main__":
+    import json
+
+    print(json.dumps(main(), indent=2))
