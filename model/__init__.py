@@ -10,7 +10,8 @@ Public API::
 """
 
 from .coefficients import Coefficients, default_coefficients, load_coefficients
-from .contact import ContactState, contact
+from .contact import ContactState, contact, contact_from_radius
+from .fast import ContactLaw, contact_table
 from .material import Material
 from .sphere import Sphere
 
@@ -18,7 +19,10 @@ __all__ = [
     "Material",
     "Sphere",
     "contact",
+    "contact_from_radius",
     "ContactState",
+    "ContactLaw",
+    "contact_table",
     "Coefficients",
     "load_coefficients",
     "default_coefficients",

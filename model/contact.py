@@ -11,9 +11,9 @@ import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
 from .sphere import Sphere
-from .unified import pair
+from .unified import UnifiedState, pair
 
-__all__ = ["ContactState", "contact", "as_approach"]
+__all__ = ["ContactState", "contact", "contact_from_radius", "as_approach"]
 
 
 class ContactState(NamedTuple):
@@ -76,3 +76,16 @@ def contact(s1: Sphere, s2: Sphere, h, coeffs: Coefficients | None = None) -> Co
         for k in ("F", "a", "h1", "h2", "stiffness", "p_m", "kappa", "rho1", "rho2"):
             out[k][on] = getattr(st, k)
     return ContactState(**{k: _shaped(v.reshape(hh.shape)) for k, v in out.items()})
+
+
+def contact_from_radius(s1: Sphere, s2: Sphere, a, coeffs: Coefficients | None = None
+                        ) -> UnifiedState:
+    """The unified model given the contact radius (DESIGN §3, forward direction).
+
+    Returns the full :class:`~spherecontact.model.unified.UnifiedState` (κ, ρ_1, ρ_2,
+    p_m, h_1, h_2, h, F, dF/dh, Λ_1, Λ_2) as 1-D arrays for contact radii a > 0.
+    """
+    aa = as_approach(a).reshape(-1)
+    if not np.all(aa > 0.0):
+        raise ValueError("a (contact radius) must be > 0")
+    return pair(s1, s2, default_coefficients() if coeffs is None else coeffs).state_at_a(aa)

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from spherecontact.model import Material, Sphere, contact
+from spherecontact.model import Material, Sphere, contact, contact_from_radius
 from spherecontact.model.coefficients import LITERATURE, Coefficients
 from spherecontact.model.single import indent
 from spherecontact.model.unified import UnifiedPair
@@ -186,3 +186,14 @@ def test_fully_plastic_level_III_values():
 def test_bad_input_raises_value_error_naming_parameter(make, match):
     with pytest.raises(ValueError, match=match):
         make()
+
+
+def test_forward_from_radius_matches_inversion():
+    s1, s2 = PAIRS["dissimilar_table"]
+    h = R * np.geomspace(1e-8, 0.3, 15)
+    st = contact(s1, s2, h, CO)
+    fw = contact_from_radius(s1, s2, st.a, CO)
+    assert np.allclose(fw.h, h, rtol=1e-10) and np.allclose(fw.F, st.F, rtol=1e-10)
+    assert np.allclose(fw.kappa, st.kappa, rtol=1e-8)
+    with pytest.raises(ValueError, match="contact radius"):
+        contact_from_radius(s1, s2, [0.0, 1e-5], CO)
