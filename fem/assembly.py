@@ -90,9 +90,12 @@ class Discretisation:
 
     def tangent(self, A: np.ndarray) -> sp.csr_matrix:
         """K = Σ_q w_q Bᵀ A B (A: (5, 5, n_points)) on the fixed CSR pattern."""
-        AB = np.einsum("klq,qlj,q->qkj", A, self.B, self.weights)
-        Kq = np.einsum("qki,qkj->qij", self.B, AB)
-        Ke = Kq.reshape(self.n_elements, self.n_qp, *Kq.shape[1:]).sum(axis=1)
+        Aw = (A * self.weights).transpose(2, 0, 1)  # (q, 5, 5)
+        AB = np.matmul(Aw, self.B)  # (q, 5, n)
+        nel, nqp, nb = self.n_elements, self.n_qp, self.B.shape[2]
+        # Σ_q B_qᵀ (A B)_q per element as one batched product over the stacked (q, k) index
+        Bt = self.B.reshape(nel, nqp * 5, nb).transpose(0, 2, 1)
+        Ke = np.matmul(Bt, AB.reshape(nel, nqp * 5, nb))
         data = np.bincount(self._slot, weights=Ke.ravel(), minlength=self._nnz)
         return sp.csr_matrix((data, self._indices, self._indptr), shape=(self.n_dofs,) * 2)
 

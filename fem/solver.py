@@ -26,7 +26,7 @@ from ..model.material import Material
 from .assembly import Discretisation
 from .contact import RigidObstacle, contact_edge, surface_areas
 from .mesh import build_mesh
-from .plasticity import PlasticState, stress_and_tangent
+from .plasticity import PlasticState, stress_and_tangent, stress_update
 
 
 class IncrementFailed(RuntimeError):
@@ -41,8 +41,8 @@ class SolverOptions:
     dh_max: float = 0.01
     dh_min: float = 1e-7
     growth: float = 1.5
-    easy_iterations: int = 5  # grow the increment after at most this many iterations
-    max_iterations: int = 20
+    easy_iterations: int = 7  # grow the increment after at most this many iterations
+    max_iterations: int = 25
     tol: float = 1e-8  # ‖free residual‖∞ ≤ tol · largest reaction
 
     def validate(self) -> None:
@@ -134,6 +134,7 @@ class IndentationSolver:
         self.n_points = self.disc.n_elements * self.disc.n_qp
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
         self._nd = nd
+        self.line_search = "energy"
 
     # ------------------------------------------------------------------ one Newton solve
     def _frame(self, active: np.ndarray, normal: np.ndarray):
@@ -182,11 +183,18 @@ class IndentationSolver:
             fs = np.stack([f[2 * self.surface], f[2 * self.surface + 1]])
             lam = np.einsum("ci,ci->i", fs, normal)
             if not frozen:
-                new_active = np.where(active, lam > 0.0, gap < -1e-12 * R)
+                wants = np.where(active, lam > 0.0, gap < -1e-12 * R)
+                # the contact of a sphere on a flat or sphere is a disc: close every node up to
+                # the outermost one that wants contact (no holes from transient tensile forces)
+                new_active = np.zeros_like(active)
+                if wants.any():
+                    new_active[: np.flatnonzero(wants).max() + 1] = True
                 key = new_active.tobytes()
                 if not np.array_equal(new_active, active):
                     changes += 1
-                    if key in seen:  # cycling between sets at the contact edge: keep the larger
+                    if key in seen and np.count_nonzero(new_active != active) == 1:
+                        # the edge node flips in and out (one node of contact resolution):
+                        # keep it closed and finish the increment with that set
                         new_active = new_active | active
                         frozen = True
                     seen.add(key)
@@ -236,10 +244,48 @@ class IndentationSolver:
             du[free] = lu.solve(rhs)
             if T is not None:
                 du = T @ du
-            u = u + du
+            u = self._line_search(u, du, free, T, state, r[free])
             self.timers["solve"] += time.perf_counter() - t3
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {res_hist[-1]:.2e})")
+
+    def _line_search(self, u, du, free, T, state, r0, max_steps: int = 4):
+        """u + α du by an energy line search (Crisfield 1991, §9.3).
+
+        s(α) = du_f · r_f(u + α du) is the slope of the potential along the step;
+        α = 1 is taken when |s(1)| ≤ ½|s(0)|, otherwise α moves to the secant zero
+        of s (clipped to [0.1, 1]). Steps that would invert an element are halved.
+        """
+        if self.line_search == "none":
+            return self._admissible(u, du)
+        duf = (T.T @ du)[free] if T is not None else du[free]
+        s0 = float(np.dot(duf, r0))
+        if s0 >= 0.0:
+            return self._admissible(u, du)
+        alpha, lo, s_lo = 1.0, 0.0, s0
+        for _ in range(max_steps):
+            trial, alpha = self._admissible(u, alpha * du, with_alpha=True, base_alpha=alpha)
+            Fv = self.disc.deformation_gradient(trial)
+            f = self.disc.internal_force(stress_update(Fv, state.cp_inv, state.eps_p, self.material).P)
+            r = T.T @ f if T is not None else f
+            s_a = float(np.dot(duf, r[free]))
+            if abs(s_a) <= 0.5 * abs(s0):
+                return trial
+            if s_a < 0.0:  # still descending: the zero lies beyond α
+                return trial
+            new = lo + (alpha - lo) * s_lo / (s_lo - s_a)
+            alpha = float(np.clip(new, 0.1 * alpha, alpha))
+        return u + alpha * du
+
+    def _admissible(self, u, du, halvings: int = 6, with_alpha: bool = False, base_alpha: float = 1.0):
+        """u + β du with the largest β = 2^-k keeping every Jacobian positive."""
+        beta = 1.0
+        for _ in range(halvings + 1):
+            Fv = self.disc.deformation_gradient(u + beta * du)
+            if np.all(Fv[0] * Fv[3] - Fv[1] * Fv[2] > 0) and np.all(Fv[4] > 0):
+                return (u + beta * du, base_alpha * beta) if with_alpha else u + beta * du
+            beta *= 0.5
+        raise IncrementFailed("inverted element (J <= 0) even after step halving")
 
     # ------------------------------------------------------------------ the incremental run
     def run(self, h_max: float, progress=None) -> RunResult:
@@ -252,6 +298,7 @@ class IndentationSolver:
         t_start = time.perf_counter()
         for k in self.timers:
             self.timers[k] = 0.0
+        self.rejected = []
         nd = self._nd
         u = np.zeros(nd)
         u_prev = None
@@ -276,6 +323,7 @@ class IndentationSolver:
                 u_new, upd, act, its, changes, res_hist, f, gap = self._newton(
                     u_pred, h_new, state, active.copy())
             except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
+                self.rejected.append((h_new, dh, str(err)))
                 dh *= 0.5
                 if dh < opt.dh_min * R:
                     status = "stopped"
