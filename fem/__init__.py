@@ -1,1 +1,5 @@
 """Axisymmetric large-deformation elastic–plastic FE solver for sphere contact (DESIGN §4)."""
+
+from .io import Run, read_run, run_indentation, write_run
+
+__all__ = ["Run", "read_run", "run_indentation", "write_run"]

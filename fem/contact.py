@@ -107,3 +107,32 @@ def contact_edge(r_ref: np.ndarray, r_cur: np.ndarray, gap: np.ndarray, active: 
     frac = (a_ref - lo) / (hi - lo)
     a_cur = float(r_cur[k] + frac * (r_cur[k + 1] - r_cur[k]))
     return a_nodes, a_cur, a_ref
+
+
+def smooth_contact_radius(h: np.ndarray, a_raw: np.ndarray, half_window: int = 3) -> np.ndarray:
+    """Contact radius smoothed over neighbouring increments.
+
+    Nodal contact on quadratic edges makes the per-increment sub-element
+    estimate alternate with the parity (corner/midside) of the outermost
+    closed node: ±0.2 % rms scatter in a for an elastic sphere, while F(h) is
+    smooth to 0.02 %. Under monotone loading a(h) is smooth, so each a is
+    replaced by the value at its own h of a local quadratic least-squares fit of
+    a² against h over ``2 half_window + 1`` increments (fewer at the ends). No
+    increment with a = 0 is used or changed.
+    """
+    h = np.asarray(h, dtype=float)
+    a_raw = np.asarray(a_raw, dtype=float)
+    out = a_raw.copy()
+    idx = np.flatnonzero(a_raw > 0)
+    if idx.size < 4:
+        return out
+    hh, aa2 = h[idx], a_raw[idx] ** 2
+    n = idx.size
+    for j in range(n):
+        lo = max(0, min(j - half_window, n - 2 * half_window - 1))
+        hi = min(n, lo + 2 * half_window + 1)
+        x = hh[lo:hi] - hh[j]
+        deg = 2 if hi - lo >= 5 else 1
+        coef = np.polynomial.polynomial.polyfit(x, aa2[lo:hi], deg)
+        out[idx[j]] = np.sqrt(max(coef[0], 0.0))
+    return out

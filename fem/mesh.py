@@ -24,9 +24,10 @@ import skfem
 DENSITY_RANGE = (0.25, 4.0)
 
 # Element sizes at density 1, in units of R.
-SIZE_POLE = 0.0025  # at the contact pole (r < 0.08 R)
+SIZE_POLE = 0.003  # within _POLE_DIST of the contact pole
 SIZE_ARC = 0.02  # along the whole arc
 SIZE_BULK = 0.10  # far from the arc
+_POLE_DIST = 0.07  # radius of the finest zone around the pole
 
 
 @dataclass(frozen=True)
@@ -92,7 +93,7 @@ def _gmsh_quad8(radius: float, density: float, linear: bool) -> tuple[np.ndarray
         t_pole = field.add("Threshold")
         field.setNumber(t_pole, "InField", d_pole)
         for key, val in (("SizeMin", SIZE_POLE * R / density), ("SizeMax", SIZE_BULK * R / density),
-                         ("DistMin", 0.08 * R), ("DistMax", 0.6 * R)):
+                         ("DistMin", _POLE_DIST * R), ("DistMax", 0.6 * R)):
             field.setNumber(t_pole, key, val)
         d_arc = field.add("Distance")
         field.setNumbers(d_arc, "CurvesList", [arc])

@@ -24,7 +24,7 @@ import scipy.sparse.linalg as spla
 
 from ..model.material import Material
 from .assembly import Discretisation
-from .contact import RigidObstacle, contact_edge, surface_areas
+from .contact import RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
 from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 
@@ -376,6 +376,12 @@ class IndentationSolver:
         curves = {k: np.asarray(getattr(hist, k), dtype=float) for k in (
             "h", "F", "F_support", "a", "a_nodes", "a_ref", "p_m", "eps_p_max", "work_external",
             "energy_elastic", "dissipation", "iterations", "active_changes")}
+        # a: sub-element estimates smoothed over increments; the raw ones are kept
+        curves["a_raw"], curves["a_ref_raw"] = curves["a"], curves["a_ref"]
+        curves["a"] = smooth_contact_radius(curves["h"], curves["a_raw"])
+        curves["a_ref"] = smooth_contact_radius(curves["h"], curves["a_ref_raw"])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            curves["p_m"] = np.where(curves["a"] > 0, curves["F"] / (np.pi * curves["a"] ** 2), 0.0)
         curves["iterations"] = curves["iterations"].astype(int)
         curves["active_changes"] = curves["active_changes"].astype(int)
         nsurf = self.surface.size

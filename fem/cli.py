@@ -1,0 +1,258 @@
+"""``spherecontact fem run``: one FE indentation run written to an HDF5 run file.
+
+A thin layer over :func:`spherecontact.fem.io.run_indentation` and
+:func:`spherecontact.fem.io.write_run`. Every input is validated before the
+mesh is built; a ValueError becomes one line on stderr and exit code 2 (top
+level). Exit code 0 when the run reaches h_max, 3 when it stops early (the
+converged part is still written, flagged ``stopped`` with its reason).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+
+from ..model.material import Material
+from .assembly import ELEMENTS
+from .io import check_inputs, run_indentation, write_run
+from .mesh import DENSITY_RANGE
+from .solver import SolverOptions
+
+__all__ = ["register", "run_command", "read_flow_table", "material_from_args",
+           "options_from_args", "EXIT_STOPPED"]
+
+#: exit code of a run that stopped before h_max (file written, status "stopped")
+EXIT_STOPPED = 3
+_DEFAULTS = SolverOptions()
+
+
+def read_flow_table(path) -> tuple[np.ndarray, np.ndarray]:
+    """Two-column CSV (eps_p, sigma); an optional header line and ``#`` comments allowed."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise ValueError(f"--flow-table: cannot read {path}: {err.strerror or err}") from None
+    rows = []
+    for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
+        cells = [c.strip() for c in row if c.strip()]
+        if not cells or cells[0].startswith("#"):
+            continue
+        if len(cells) != 2:
+            raise ValueError(f"--flow-table {path}, line {lineno}: expected two columns "
+                             f"eps_p, sigma, got {len(cells)}")
+        try:
+            rows.append((float(cells[0]), float(cells[1])))
+        except ValueError:
+            if rows:  # only the first non-comment line may be a header
+                raise ValueError(f"--flow-table {path}, line {lineno}: not a number: "
+                                 f"{','.join(cells)!r}") from None
+    if not rows:
+        raise ValueError(f"--flow-table {path}: no data rows")
+    table = np.array(rows)
+    return table[:, 0], table[:, 1]
+
+
+def material_from_args(args: argparse.Namespace) -> Material:
+    """Material from --E/--nu and either --sigma-y/--K/--n or --flow-table."""
+    if args.flow_table is not None:
+        given = [f for f, v in (("--sigma-y", args.sigma_y), ("--K", args.K), ("--n", args.n))
+                 if v is not None]
+        if given:
+            raise ValueError(f"--flow-table replaces --sigma-y/--K/--n; drop {', '.join(given)}")
+        eps, sigma = read_flow_table(args.flow_table)
+        try:
+            return Material.from_table(args.E, args.nu, eps, sigma)
+        except ValueError as err:
+            raise ValueError(f"--flow-table {args.flow_table}: {err}") from None
+    return Material(E=args.E, nu=args.nu,
+                    sigma_y=math.inf if args.sigma_y is None else args.sigma_y,
+                    K=0.0 if args.K is None else args.K, n=1.0 if args.n is None else args.n)
+
+
+def options_from_args(args: argparse.Namespace) -> SolverOptions:
+    """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol."""
+    return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
+                         max_iterations=args.max_iterations, tol=args.tol)
+
+
+def _check_output(out) -> Path:
+    """The output path: its directory must exist, and it must not be a directory."""
+    path = Path(out)
+    if path.is_dir():
+        raise ValueError(f"--out {out} is a directory; give a file name such as run.h5")
+    if not path.parent.is_dir():
+        raise ValueError(f"--out: directory {path.parent} does not exist")
+    return path
+
+
+class _Progress:
+    """tqdm bar over h/h_max on stderr (off with --quiet or when stderr is no TTY)."""
+
+    def __init__(self, h_max: float, quiet: bool):
+        from tqdm import tqdm
+
+        disable = quiet or not sys.stderr.isatty()
+        self.bar = tqdm(total=h_max, file=sys.stderr, disable=disable, desc="fem run",
+                        bar_format="{desc}: {percentage:3.0f}%|{bar}| h = {n:.4g}/{total:.4g} "
+                                   "[{elapsed}<{remaining}]")
+
+    def __call__(self, h: float) -> None:
+        self.bar.update(h - self.bar.n)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+def _summary(result, path: Path) -> str:
+    """One line: status, increments, Newton iterations, wall time, final F and a, file."""
+    t = result.timings
+    n = len(result.curves["h"])
+    last = (f"h = {result.h[-1]:.6g}, F = {result.F[-1]:.6g}, a = {result.a[-1]:.6g}" if n
+            else "no converged increment")
+    return (f"fem run {result.status}: {n} increments, {t.get('newton_iterations', 0)} Newton "
+            f"iterations, wall {t.get('wall_s', float('nan')):.2f} s; {last} -> {path}")
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """CLI handler of ``fem run``: validate, run, write, summarise; return the exit code."""
+    material = material_from_args(args)
+    options = options_from_args(args)
+    out = _check_output(args.out)
+    check_inputs(material, args.radius, args.h_max, args.indenter_radius, args.mesh_density,
+                 args.element, options)
+    bar = _Progress(args.h_max, args.quiet)
+    try:
+        result = run_indentation(material, args.radius, args.h_max,
+                                 indenter_radius=args.indenter_radius, density=args.mesh_density,
+                                 element=args.element, options=options, progress=bar)
+    finally:
+        bar.close()
+    extra = {"entry_point": "spherecontact fem run",
+             "flow_table": "" if args.flow_table is None else str(args.flow_table)}
+    write_run(out, result, extra_provenance=extra)
+    if result.status != "converged":
+        print(f"spherecontact fem run: stopped early: {result.reason}", file=sys.stderr)
+    print(_summary(result, out))
+    return 0 if result.status == "converged" else EXIT_STOPPED
+
+
+# ============================================================================ argparse
+def _add_material(add) -> None:
+    """Material options (``add(group_title, *flags, **kw)`` adds one option)."""
+    grp = "material (consistent units: stresses in the unit of E)"
+    add(grp, "--E", type=float, required=True, help="Young's modulus E, > 0")
+    add(grp, "--nu", type=float, default=0.3, help="Poisson's ratio, in (-1, 0.5) (default 0.3)")
+    add(grp, "--sigma-y", type=float, default=None,
+        help="initial yield stress sigma_Y, > 0 (default inf: purely elastic)")
+    add(grp, "--K", type=float, default=None,
+        help="Ludwik hardening modulus K >= 0 in sigma_f = sigma_Y + K eps_p^n "
+             "(default 0: perfectly plastic)")
+    add(grp, "--n", type=float, default=None, help="Ludwik hardening exponent n >= 0 (default 1)")
+    add(grp, "--flow-table", metavar="FILE.csv", default=None,
+        help="tabulated flow curve instead of --sigma-y/--K/--n: two CSV columns eps_p, sigma "
+             "(optional header, '#' comments); eps_p starts at 0 and increases strictly, "
+             "sigma > 0 non-decreasing; extrapolated with the last slope")
+
+
+def _add_geometry(add) -> None:
+    """Geometry and loading options."""
+    grp = "geometry and loading (lengths in the unit of --radius)"
+    add(grp, "--radius", type=float, default=1.0, help="sphere radius R, finite > 0 (default 1)")
+    add(grp, "--h-max", type=float, required=True,
+        help="final approach h (shortening pole to equatorial plane), in (0, 0.8 R]")
+    add(grp, "--indenter-radius", type=float, default=math.inf, metavar="R2",
+        help="radius of a rigid spherical indenter, > 0 (default inf: rigid flat, i.e. two "
+             "equal spheres by symmetry)")
+
+
+def _add_numerics(add) -> None:
+    """Mesh and solver options."""
+    lo, hi = DENSITY_RANGE
+    grp = "mesh and solver"
+    add(grp, "--mesh-density", type=float, default=1.0,
+        help=f"mesh-density factor in [{lo:g}, {hi:g}]; element sizes scale as 1/density "
+             "(default 1)")
+    add(grp, "--element", choices=sorted(ELEMENTS), default="q8r",
+        help="q8r: 8-node quads, 2x2 reduced integration (default, no locking); "
+             "q4: bilinear quads, full integration (locks; for comparison)")
+    add(grp, "--dh-first", type=float, default=_DEFAULTS.dh_first,
+        help="first increment of h as a fraction of R, in [dh-min, dh-max] "
+             f"(default {_DEFAULTS.dh_first:g})")
+    add(grp, "--dh-max", type=float, default=_DEFAULTS.dh_max,
+        help=f"largest increment of h as a fraction of R, > 0 (default {_DEFAULTS.dh_max:g})")
+    add(grp, "--dh-min", type=float, default=_DEFAULTS.dh_min,
+        help="smallest increment as a fraction of R; the run stops when a cut-back goes "
+             f"below it (default {_DEFAULTS.dh_min:g})")
+    add(grp, "--max-iterations", type=int, default=_DEFAULTS.max_iterations,
+        help="Newton iterations per increment before a cut-back, integer in [2, 200] "
+             f"(default {_DEFAULTS.max_iterations})")
+    add(grp, "--tol", type=float, default=_DEFAULTS.tol,
+        help="Newton tolerance: largest free residual / largest reaction, > 0 "
+             f"(default {_DEFAULTS.tol:g})")
+
+
+def _add_output(add) -> None:
+    """Output options."""
+    add("output", "--out", required=True, metavar="FILE.h5",
+        help="HDF5 run file to write (replaced atomically)")
+    add("output", "--quiet", action="store_true",
+        help="no progress bar (it is also off when stderr is not a terminal)")
+
+
+def _build_run_parser(cmds) -> list:
+    """Add ``fem run``; return its options as (flags, help) for the stage overview."""
+    run = cmds.add_parser(
+        "run", help="one indentation run up to --h-max, written to an HDF5 file",
+        description="Press an elastic-plastic hemisphere on a rigid obstacle up to --h-max and "
+                    "write curves (h, F, a, p_m, energies, ...), Newton residual histories, "
+                    "pressure profiles and the final mesh to --out. Units are consistent: "
+                    "lengths in the unit of --radius, stresses in the unit of --E.",
+        epilog="Exit codes: 0 reached h-max; 2 bad input (nothing computed); 3 stopped early "
+               "(file written with status 'stopped' and the reason).")
+    groups: dict = {}
+    listed = []
+
+    def add(title, *flags, **kw):
+        if title not in groups:
+            groups[title] = run.add_argument_group(title)
+        groups[title].add_argument(*flags, **kw)
+        listed.append((", ".join(flags), kw["help"]))
+
+    for adder in (_add_material, _add_geometry, _add_numerics, _add_output):
+        adder(add)
+    run.set_defaults(func=run_command)
+    return listed
+
+
+def _option_table(listed, width: int = 79) -> str:
+    """Two-column text: option flags, then the wrapped help."""
+    col = max(len(f) for f, _ in listed) + 4
+    lines = []
+    for flags, text in listed:
+        wrapped = textwrap.wrap(text, width - col) or [""]
+        lines.append(f"  {flags:<{col - 2}}{wrapped[0]}")
+        lines += [" " * col + w for w in wrapped[1:]]
+    return "\n".join(lines)
+
+
+def register(subparsers) -> None:
+    """Add the ``fem`` stage and its ``run`` command to the top-level parser."""
+    fem = subparsers.add_parser(
+        "fem", help="FE reference solver (one hemisphere on a rigid flat or sphere)",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Axisymmetric large-deformation elastic-plastic FE solver: one hemisphere\n"
+                    "pressed on a rigid flat (equal spheres by symmetry) or a rigid sphere.\n"
+                    "'run' computes one force-approach curve into an HDF5 run file\n"
+                    "(read it back with spherecontact.fem.read_run).")
+    cmds = fem.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    listed = _build_run_parser(cmds)
+    fem.epilog = ("options of 'fem run' (lengths in the unit of --radius, stresses in the "
+                  "unit of --E):\n" + _option_table(listed)
+                  + "\n\nExit codes of 'fem run': 0 reached h-max; 2 bad input; 3 stopped early.")

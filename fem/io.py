@@ -1,0 +1,555 @@
+"""One FE run on disk: validated entry point, HDF5 writer and reader.
+
+A run file holds a single group ``run`` (schema ``spherecontact.fem.run``,
+version 1), so a database can later copy it as one group among many
+(``h5py.Group.copy``) and read it back with :func:`run_from_group`::
+
+    run/                      attrs: schema, schema_version, status, reason, units,
+                                     n_increments, input.* (flattened inputs),
+                                     provenance.* (versions, git commit, host, date,
+                                     wall time, timings.*, newton.*, extra.*)
+      curves/<name>           (n_inc,)   one per recorded curve; attrs units, description
+      newton/residuals        (n_res,)   relative residual norms of all increments, concatenated
+      newton/offsets          (n_inc+1,) increment k owns residuals[offsets[k]:offsets[k+1]]
+      profiles/r              (n_inc, n_surf) deformed radius of the surface nodes
+      profiles/p              (n_inc, n_surf) contact pressure
+      profiles/gap            (n_inc, n_surf) gap to the obstacle (0 where in contact)
+      mesh/X                  (2, n_nodes) reference coordinates (r, z)
+      mesh/u                  (2 n_nodes,) final displacement, interleaved (u_r, u_z)
+      mesh/cells              (n_el, 8|4) node indices
+      mesh/eps_p              (n_el, n_qp) final equivalent plastic strain at the Gauss points
+
+Units are consistent: lengths in the unit of the radius, stresses in the unit
+of E, forces = stress × length², energies = force × length.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import os
+import platform
+import secrets
+import socket
+import subprocess
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from ..model.material import Material
+from .assembly import ELEMENTS
+from .contact import RigidObstacle
+from .mesh import DENSITY_RANGE
+from .solver import IndentationSolver, RunResult, SolverOptions
+
+__all__ = [
+    "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "Run", "check_inputs", "run_indentation",
+    "write_run", "write_run_group", "read_run", "run_from_group", "provenance",
+]
+
+SCHEMA = "spherecontact.fem.run"
+SCHEMA_VERSION = 1
+#: name of the run group in a single-run file
+GROUP = "run"
+UNITS = "consistent units; lengths in the unit of radius"
+STATUSES = ("converged", "stopped")
+#: arrays larger than this many bytes are gzip-compressed
+COMPRESS_ABOVE = 4096
+INPUT_PREFIX = "input."
+PROVENANCE_PREFIX = "provenance."
+
+#: recorded curves: name → (unit, description)
+CURVES = {
+    "h": ("length", "approach: shortening between the equatorial plane and the pole"),
+    "F": ("force", "contact force from the contact reactions"),
+    "F_support": ("force", "reaction on the equatorial plane (equals F in equilibrium)"),
+    "a": ("length", "contact radius, sub-element estimate (deformed configuration)"),
+    "a_nodes": ("length", "contact radius at the outermost closed node (deformed)"),
+    "a_ref": ("length", "contact radius, sub-element estimate (reference configuration)"),
+    "p_m": ("stress", "mean contact pressure F / (pi a^2)"),
+    "eps_p_max": ("1", "largest equivalent plastic strain"),
+    "work_external": ("energy", "external work, trapezoidal integral of F dh"),
+    "energy_elastic": ("energy", "stored elastic (Hencky) energy"),
+    "dissipation": ("energy", "plastic dissipation"),
+    "iterations": ("count", "Newton iterations of the increment"),
+    "active_changes": ("count", "contact active-set changes in the increment"),
+}
+PROFILES = {"r": "profile_r", "p": "profile_p", "gap": "profile_g"}
+PROFILE_UNITS = {"r": "length", "p": "stress", "gap": "length"}
+MESH = ("X", "u", "cells", "eps_p")
+CELL_TYPES = {8: "quad8", 4: "quad"}
+
+
+# ============================================================================ running
+def _as_float(value) -> float:
+    """``float(value)``, or NaN when it is not a number (the caller reports it)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
+                 element="q8r", options=None, progress=None) -> dict:
+    """Validate every input of :func:`run_indentation`; return them normalised.
+
+    Raises ValueError naming the parameter and its allowed range.
+    """
+    if not isinstance(material, Material):
+        raise ValueError(f"material must be a Material, got {type(material).__name__}")
+    if material.is_rigid:
+        raise ValueError("material: the deformable sphere must not be rigid (E = inf)")
+    R = _as_float(radius)
+    if not (math.isfinite(R) and R > 0.0):
+        raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
+    h = _as_float(h_max)
+    if not (math.isfinite(h) and 0.0 < h <= 0.8 * R):
+        raise ValueError(f"h_max must lie in (0, 0.8 radius] = (0, {0.8 * R:g}], got {h_max!r}")
+    R2 = _as_float(indenter_radius)
+    if not R2 > 0.0:
+        raise ValueError(
+            f"indenter_radius must be > 0 (inf for a rigid flat), got {indenter_radius!r}")
+    lo, hi = DENSITY_RANGE
+    d = _as_float(density)
+    if not (math.isfinite(d) and lo <= d <= hi):
+        raise ValueError(f"mesh density must lie in [{lo:g}, {hi:g}], got {density!r}")
+    if element not in ELEMENTS:
+        raise ValueError(f"element must be one of {sorted(ELEMENTS)}, got {element!r}")
+    options = SolverOptions() if options is None else options
+    if not isinstance(options, SolverOptions):
+        raise ValueError(f"options must be a SolverOptions, got {type(options).__name__}")
+    options.validate()
+    if progress is not None and not callable(progress):
+        raise ValueError("progress must be a callable progress(h) or None")
+    return {"material": material, "radius": R, "h_max": h, "indenter_radius": R2,
+            "density": d, "element": element, "options": options, "progress": progress}
+
+
+def run_indentation(material: Material, radius: float, h_max: float,
+                    indenter_radius: float = math.inf, density: float = 1.0,
+                    element: str = "q8r", options: SolverOptions | None = None,
+                    progress: Callable[[float], object] | None = None) -> RunResult:
+    """Press a hemisphere of ``radius`` and ``material`` on a rigid obstacle up to ``h_max``.
+
+    ``indenter_radius = inf`` is a rigid flat (equal spheres by symmetry), a finite
+    value a rigid sphere. ``density`` scales the mesh (``DENSITY_RANGE``), ``element``
+    is ``"q8r"`` (8-node, reduced integration) or ``"q4"`` (bilinear, locks).
+    Every input is checked before any mesh is built; ``progress(h)`` is called
+    after each converged increment. Returns the solver's ``RunResult``.
+    """
+    a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
+                     progress)
+    solver = IndentationSolver(a["material"], a["radius"],
+                               obstacle=RigidObstacle(a["indenter_radius"]),
+                               density=a["density"], element=a["element"], options=a["options"])
+    return solver.run(a["h_max"], progress=a["progress"])
+
+
+# ============================================================================ provenance
+def _git_commit() -> str:
+    """Commit of the source tree holding this package, or ``"unknown"``."""
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).resolve().parent,
+                             capture_output=True, text=True, timeout=10, check=True)
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    commit = out.stdout.strip()
+    return commit if len(commit) == 40 else "unknown"
+
+
+def _version(module: str) -> str:
+    """``module.__version__`` or ``"unknown"``."""
+    try:
+        return str(__import__(module).__version__)
+    except (ImportError, AttributeError):
+        return "unknown"
+
+
+def newton_statistics(result: RunResult) -> dict:
+    """Increment and Newton-iteration counts and the worst converged residual."""
+    its = np.asarray(result.curves.get("iterations", []), dtype=float)
+    changes = np.asarray(result.curves.get("active_changes", []), dtype=float)
+    last = [float(r[-1]) for r in result.residuals if len(r)]
+    return {
+        "increments": int(its.size),
+        "iterations_total": int(its.sum()),
+        "iterations_mean": float(its.mean()) if its.size else 0.0,
+        "iterations_max": int(its.max()) if its.size else 0,
+        "active_changes_total": int(changes.sum()),
+        "residual_converged_max": max(last) if last else 0.0,
+    }
+
+
+def provenance(result: RunResult, extra: dict | None = None) -> dict:
+    """Provenance of a run: versions, git commit, host, date, timings, Newton statistics."""
+    from spherecontact import __version__
+
+    prov = {
+        "package_version": __version__,
+        "git_commit": _git_commit(),
+        "hostname": socket.gethostname(),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scikit_fem": _version("skfem"),
+        "h5py": h5py.__version__,
+        "date_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "wall_s": float(result.timings.get("wall_s", math.nan)),
+        "timings": dict(result.timings),
+        "newton": newton_statistics(result),
+    }
+    if extra:
+        prov["extra"] = dict(extra)
+    return prov
+
+
+# ============================================================================ attributes
+def _attr_value(value):
+    """A value h5py can store as an attribute (numbers, strings, numeric arrays)."""
+    if isinstance(value, bool | np.bool_):
+        return np.bool_(value)
+    if isinstance(value, int | np.integer):
+        return np.int64(value)
+    if isinstance(value, float | np.floating):
+        return np.float64(value)
+    if isinstance(value, str):
+        return value
+    if isinstance(value, list | tuple | np.ndarray):
+        arr = np.asarray(value)
+        if arr.dtype.kind in "biuf":
+            return arr
+    return str(value)
+
+
+def _flatten(prefix: str, d: dict) -> dict:
+    """Nested dict → ``{prefix + "a.b": value}``."""
+    out = {}
+    for key, value in d.items():
+        if "." in str(key):
+            raise ValueError(f"attribute key {key!r} must not contain '.'")
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            out.update(_flatten(name + ".", value))
+        else:
+            out[name] = _attr_value(value)
+    return out
+
+
+def _python_value(value):
+    """An attribute read by h5py → plain Python (float, int, bool, str, list)."""
+    if isinstance(value, bytes):
+        return value.decode()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        return float(value)
+    return value
+
+
+def _unflatten(attrs, prefix: str) -> dict:
+    """Inverse of :func:`_flatten` for the attributes starting with ``prefix``."""
+    out: dict = {}
+    for name, value in attrs.items():
+        if not name.startswith(prefix):
+            continue
+        *parents, leaf = name[len(prefix):].split(".")
+        node = out
+        for p in parents:
+            node = node.setdefault(p, {})
+        node[leaf] = _python_value(value)
+    return out
+
+
+# ============================================================================ writing
+def _dataset(group: h5py.Group, name: str, data, **attrs) -> h5py.Dataset:
+    """Create a dataset, gzip-compressed when larger than ``COMPRESS_ABOVE`` bytes."""
+    arr = np.ascontiguousarray(data)
+    kw = {"compression": "gzip", "compression_opts": 4, "shuffle": True} \
+        if arr.nbytes > COMPRESS_ABOVE else {}
+    ds = group.create_dataset(name, data=arr, **kw)
+    for key, value in attrs.items():
+        ds.attrs[key] = value
+    return ds
+
+
+def _ragged(lists) -> tuple[np.ndarray, np.ndarray]:
+    """List of 1-D sequences → (concatenated values, offsets of length n + 1)."""
+    lengths = np.array([len(x) for x in lists], dtype=np.int64)
+    offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.int64)
+    values = np.concatenate([np.asarray(x, dtype=float) for x in lists]) if lists else np.zeros(0)
+    return values, offsets
+
+
+def write_run_group(parent: h5py.Group, name: str, result: RunResult,
+                    prov: dict | None = None) -> h5py.Group:
+    """Write ``result`` as the group ``parent[name]`` (layout in the module docstring).
+
+    ``prov`` is the provenance dict (default: :func:`provenance` of ``result``).
+    """
+    if result.status not in STATUSES:
+        raise ValueError(f"status must be one of {STATUSES}, got {result.status!r}")
+    prov = provenance(result) if prov is None else prov
+    g = parent.create_group(name)
+    g.attrs["schema"] = SCHEMA
+    g.attrs["schema_version"] = np.int64(SCHEMA_VERSION)
+    g.attrs["status"] = result.status
+    g.attrs["reason"] = result.reason
+    g.attrs["units"] = UNITS
+    n = int(np.asarray(result.curves["h"]).size)
+    g.attrs["n_increments"] = np.int64(n)
+    for key, value in _flatten(INPUT_PREFIX, result.inputs).items():
+        g.attrs[key] = value
+    for key, value in _flatten(PROVENANCE_PREFIX, prov).items():
+        g.attrs[key] = value
+    curves = g.create_group("curves")
+    for cname, values in result.curves.items():
+        unit, description = CURVES.get(cname, ("", ""))
+        _dataset(curves, cname, np.asarray(values), units=unit, description=description)
+    newton = g.create_group("newton")
+    values, offsets = _ragged(result.residuals)
+    _dataset(newton, "residuals", values, units="1",
+             description="relative residual norms per Newton iteration, all increments")
+    _dataset(newton, "offsets", offsets, units="index",
+             description="increment k owns residuals[offsets[k]:offsets[k+1]]")
+    profiles = g.create_group("profiles")
+    profiles.attrs["description"] = "per increment (rows) and surface node from the pole (columns)"
+    for pname, attr in PROFILES.items():
+        _dataset(profiles, pname, np.asarray(getattr(result, attr), dtype=float),
+                 units=PROFILE_UNITS[pname])
+    _write_mesh(g, result.final)
+    return g
+
+
+def _write_mesh(g: h5py.Group, final: dict) -> None:
+    """The final state: reference nodes, displacement, cells and plastic strain."""
+    mesh = g.create_group("mesh")
+    cells = np.asarray(final["cells"], dtype=np.int64)
+    mesh.attrs["cell_type"] = CELL_TYPES.get(cells.shape[1], "unknown") if cells.ndim == 2 \
+        else "unknown"
+    mesh.attrs["node_order"] = ("4 corners counter-clockwise, then the midsides of edges 01, 12, "
+                                "23, 30 (scikit-fem ElementQuadS2 = VTK/meshio quad8)")
+    _dataset(mesh, "X", np.asarray(final["X"], dtype=float), units="length",
+             description="reference coordinates (r, z), pole at the origin")
+    _dataset(mesh, "u", np.asarray(final["u"], dtype=float), units="length",
+             description="final displacement, interleaved (u_r, u_z) per node")
+    _dataset(mesh, "cells", cells, units="index", description="node indices per element")
+    _dataset(mesh, "eps_p", np.asarray(final["eps_p"], dtype=float), units="1",
+             description="final equivalent plastic strain at the 2x2 Gauss points")
+
+
+def _temporary_sibling(path: Path) -> Path:
+    """Create an empty, uniquely named file next to ``path`` (mode 0666 minus umask)."""
+    while True:
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        except FileExistsError:
+            continue
+        return tmp
+
+
+def write_run(path, result: RunResult, extra_provenance: dict | None = None) -> Path:
+    """Write one run to the HDF5 file ``path`` atomically; return the path.
+
+    The file is written under a temporary name in the same directory, flushed to
+    disk and renamed over ``path``: an interrupted write never leaves a partial
+    file under ``path`` (and keeps any previous file there intact).
+    """
+    path = Path(path)
+    prov = provenance(result, extra_provenance)
+    tmp = _temporary_sibling(path)
+    try:
+        with h5py.File(tmp, "w") as f:
+            write_run_group(f, GROUP, result, prov)
+            f.flush()
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
+# ============================================================================ reading
+@dataclass(frozen=True, eq=False)
+class Run:
+    """One run read back from disk.
+
+    ``h``, ``F``, ``a`` and every other curve (``run.p_m``, ``run.dissipation``, …)
+    are attributes; ``curves`` maps names to the same arrays. ``residuals[k]`` is
+    the Newton residual history of increment k. Arrays are read-only.
+    """
+
+    inputs: dict
+    curves: dict
+    status: str
+    reason: str
+    provenance: dict
+    residuals: list
+    profile_r: np.ndarray
+    profile_p: np.ndarray
+    profile_gap: np.ndarray
+    mesh: dict
+    source: str = ""
+
+    def __getattr__(self, name: str):
+        """Curves as attributes (only called when normal lookup fails)."""
+        if not name.startswith("_"):
+            curves = self.__dict__.get("curves", {})
+            if name in curves:
+                return curves[name]
+        raise AttributeError(f"{type(self).__name__!r} has no attribute or curve {name!r}")
+
+    def __dir__(self):
+        return sorted(set(super().__dir__()) | set(self.__dict__.get("curves", {})))
+
+    @property
+    def h(self) -> np.ndarray:
+        """Approach per converged increment."""
+        return self.curves["h"]
+
+    @property
+    def F(self) -> np.ndarray:
+        """Contact force per converged increment."""
+        return self.curves["F"]
+
+    @property
+    def a(self) -> np.ndarray:
+        """Contact radius (sub-element estimate) per converged increment."""
+        return self.curves["a"]
+
+    @property
+    def converged(self) -> bool:
+        """True when the run reached h_max."""
+        return self.status == "converged"
+
+    @property
+    def n_increments(self) -> int:
+        return int(self.curves["h"].size)
+
+    def material(self) -> Material:
+        """The sphere's material, rebuilt from the stored inputs."""
+        m = self.inputs["material"]
+        if "eps_table" in m:
+            return Material.from_table(m["E"], m["nu"], m["eps_table"], m["sigma_table"])
+        return Material(E=m["E"], nu=m["nu"], sigma_y=m["sigma_y"], K=m["K"], n=m["n"])
+
+    def solver_options(self) -> SolverOptions:
+        """The solver options, rebuilt from the stored inputs (unknown keys ignored)."""
+        known = {f.name for f in fields(SolverOptions)}
+        return SolverOptions(**{k: v for k, v in self.inputs.get("options", {}).items()
+                                if k in known})
+
+    def deformed(self) -> np.ndarray:
+        """Final deformed node coordinates, shape (2, n_nodes)."""
+        X = self.mesh["X"]
+        return X + self.mesh["u"].reshape(-1, 2).T
+
+
+def _require(g: h5py.Group, names) -> None:
+    """ValueError listing the missing members of ``g``."""
+    missing = [n for n in names if n not in g]
+    if missing:
+        raise ValueError(f"run group {g.name!r} lacks {', '.join(missing)}")
+
+
+def _read_array(g: h5py.Group, name: str) -> np.ndarray:
+    """Dataset ``g[name]`` as a read-only array (ValueError if it is not a dataset)."""
+    obj = g[name]
+    if not isinstance(obj, h5py.Dataset):
+        raise ValueError(f"{obj.name!r} must be a dataset")
+    arr = np.asarray(obj[()])
+    arr.setflags(write=False)
+    return arr
+
+
+def _check_header(g: h5py.Group) -> None:
+    """Schema name and version of a run group."""
+    schema = _python_value(g.attrs.get("schema"))
+    if schema != SCHEMA:
+        raise ValueError(f"group {g.name!r} has schema {schema!r}, expected {SCHEMA!r}")
+    version = _python_value(g.attrs.get("schema_version"))
+    if version != SCHEMA_VERSION:
+        raise ValueError(f"unsupported schema_version {version!r} in {g.name!r} "
+                         f"(this reader knows {SCHEMA_VERSION})")
+    status = _python_value(g.attrs.get("status"))
+    if status not in STATUSES:
+        raise ValueError(f"status must be one of {STATUSES}, got {status!r}")
+    for key in ("reason", "input.material.E", "input.radius", "input.h_max"):
+        if key not in g.attrs:
+            raise ValueError(f"run group {g.name!r} lacks the attribute {key!r}")
+
+
+def _check_shapes(curves: dict, offsets, values, profiles: dict, mesh: dict) -> None:
+    """Consistency of the curve lengths, the ragged residuals, profiles and mesh."""
+    n = curves["h"].size
+    bad = [k for k, v in curves.items() if v.shape != (n,)]
+    if bad:
+        raise ValueError(f"curves {bad} do not have the length {n} of curves/h")
+    if offsets.shape != (n + 1,) or offsets[0] != 0 or np.any(np.diff(offsets) < 0) \
+            or offsets[-1] != values.size:
+        raise ValueError("newton/offsets is not a valid index into newton/residuals")
+    for name, arr in profiles.items():
+        if arr.ndim != 2 or arr.shape[0] != n:
+            raise ValueError(f"profiles/{name} must have {n} rows, got shape {arr.shape}")
+    X, u, cells, eps_p = (mesh[k] for k in MESH)
+    if X.ndim != 2 or X.shape[0] != 2 or u.shape != (2 * X.shape[1],):
+        raise ValueError(f"mesh/X {X.shape} and mesh/u {u.shape} are inconsistent")
+    if cells.ndim != 2 or eps_p.shape[:1] != cells.shape[:1] or \
+            (cells.size and (cells.min() < 0 or cells.max() >= X.shape[1])):
+        raise ValueError("mesh/cells or mesh/eps_p do not match mesh/X")
+
+
+def run_from_group(g: h5py.Group, source: str = "") -> Run:
+    """Read and validate one run group (of a run file or a database)."""
+    _check_header(g)
+    _require(g, ["curves", "newton", "profiles", "mesh"])
+    _require(g["curves"], CURVES)
+    _require(g["newton"], ["residuals", "offsets"])
+    _require(g["profiles"], PROFILES)
+    _require(g["mesh"], MESH)
+    curves = {name: _read_array(g["curves"], name) for name in g["curves"]}
+    values = _read_array(g["newton"], "residuals")
+    offsets = _read_array(g["newton"], "offsets")
+    profiles = {name: _read_array(g["profiles"], name) for name in PROFILES}
+    mesh = {name: _read_array(g["mesh"], name) for name in MESH}
+    _check_shapes(curves, offsets, values, profiles, mesh)
+    residuals = [values[offsets[k]:offsets[k + 1]] for k in range(offsets.size - 1)]
+    return Run(inputs=_unflatten(g.attrs, INPUT_PREFIX), curves=curves,
+               status=_python_value(g.attrs["status"]), reason=_python_value(g.attrs["reason"]),
+               provenance=_unflatten(g.attrs, PROVENANCE_PREFIX), residuals=residuals,
+               profile_r=profiles["r"], profile_p=profiles["p"], profile_gap=profiles["gap"],
+               mesh=mesh, source=source)
+
+
+def read_run(path, group: str = GROUP) -> Run:
+    """Read the run file ``path`` (validated: schema, version, datasets, shapes).
+
+    FileNotFoundError if ``path`` does not exist; ValueError naming the problem
+    if it is not HDF5, truncated, foreign, of another schema version or incomplete.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(2, "no such run file", str(path))
+    if not path.is_file() or not h5py.is_hdf5(str(path)):
+        raise ValueError(f"{path}: not an HDF5 file")
+    try:
+        with h5py.File(path, "r") as f:
+            if group not in f or not isinstance(f[group], h5py.Group):
+                raise ValueError(f"{path}: no group {group!r}; not a {SCHEMA} file")
+            return run_from_group(f[group], source=str(path))
+    except ValueError as err:
+        if str(err).startswith(str(path)):
+            raise
+        raise ValueError(f"{path}: {err}") from err
+    except (OSError, KeyError, RuntimeError) as err:
+        raise ValueError(f"{path}: unreadable HDF5 file (truncated or corrupt): {err}") from err
+
