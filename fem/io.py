@@ -69,6 +69,8 @@ CURVES = {
     "a": ("length", "contact radius, sub-element estimate (deformed configuration)"),
     "a_nodes": ("length", "contact radius at the outermost closed node (deformed)"),
     "a_ref": ("length", "contact radius, sub-element estimate (reference configuration)"),
+    "a_raw": ("length", "contact radius, sub-element estimate before smoothing (deformed)"),
+    "a_ref_raw": ("length", "contact radius, sub-element estimate before smoothing (reference)"),
     "p_m": ("stress", "mean contact pressure F / (pi a^2)"),
     "eps_p_max": ("1", "largest equivalent plastic strain"),
     "work_external": ("energy", "external work, trapezoidal integral of F dh"),
@@ -77,10 +79,19 @@ CURVES = {
     "iterations": ("count", "Newton iterations of the increment"),
     "active_changes": ("count", "contact active-set changes in the increment"),
 }
+#: curves every run file must hold
+REQUIRED_CURVES = ("h", "F", "F_support", "a", "a_nodes", "a_ref", "p_m", "eps_p_max",
+                   "work_external", "energy_elastic", "dissipation", "iterations",
+                   "active_changes")
 PROFILES = {"r": "profile_r", "p": "profile_p", "gap": "profile_g"}
 PROFILE_UNITS = {"r": "length", "p": "stress", "gap": "length"}
 MESH = ("X", "u", "cells", "eps_p")
 CELL_TYPES = {8: "quad8", 4: "quad"}
+NODE_ORDER = {
+    8: "4 corners counter-clockwise, then the midsides of edges 01, 12, 23, 30 "
+       "(scikit-fem ElementQuadS2, the same as VTK/meshio quad8)",
+    4: "4 corners counter-clockwise",
+}
 
 
 # ============================================================================ running
@@ -310,7 +321,7 @@ def write_run_group(parent: h5py.Group, name: str, result: RunResult,
         g.attrs[key] = value
     curves = g.create_group("curves")
     for cname, values in result.curves.items():
-        unit, description = CURVES.get(cname, ("", ""))
+        unit, description = CURVES.get(cname, ("unknown", ""))
         _dataset(curves, cname, np.asarray(values), units=unit, description=description)
     newton = g.create_group("newton")
     values, offsets = _ragged(result.residuals)
@@ -331,10 +342,9 @@ def _write_mesh(g: h5py.Group, final: dict) -> None:
     """The final state: reference nodes, displacement, cells and plastic strain."""
     mesh = g.create_group("mesh")
     cells = np.asarray(final["cells"], dtype=np.int64)
-    mesh.attrs["cell_type"] = CELL_TYPES.get(cells.shape[1], "unknown") if cells.ndim == 2 \
-        else "unknown"
-    mesh.attrs["node_order"] = ("4 corners counter-clockwise, then the midsides of edges 01, 12, "
-                                "23, 30 (scikit-fem ElementQuadS2 = VTK/meshio quad8)")
+    corners = cells.shape[1] if cells.ndim == 2 else 0
+    mesh.attrs["cell_type"] = CELL_TYPES.get(corners, "unknown")
+    mesh.attrs["node_order"] = NODE_ORDER.get(corners, "unknown")
     _dataset(mesh, "X", np.asarray(final["X"], dtype=float), units="length",
              description="reference coordinates (r, z), pole at the origin")
     _dataset(mesh, "u", np.asarray(final["u"], dtype=float), units="length",
@@ -512,7 +522,7 @@ def run_from_group(g: h5py.Group, source: str = "") -> Run:
     """Read and validate one run group (of a run file or a database)."""
     _check_header(g)
     _require(g, ["curves", "newton", "profiles", "mesh"])
-    _require(g["curves"], CURVES)
+    _require(g["curves"], REQUIRED_CURVES)
     _require(g["newton"], ["residuals", "offsets"])
     _require(g["profiles"], PROFILES)
     _require(g["mesh"], MESH)
