@@ -44,9 +44,10 @@ class SolverOptions:
     easy_iterations: int = 7  # grow the increment after at most this many iterations
     max_iterations: int = 25
     tol: float = 1e-8  # ‖free residual‖∞ ≤ tol · largest reaction
+    strain_increment: float = 0.01  # dh ≤ strain_increment · a: bounds the strain per step
 
     def validate(self) -> None:
-        for name in ("dh_first", "dh_max", "dh_min", "tol"):
+        for name in ("dh_first", "dh_max", "dh_min", "tol", "strain_increment"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
@@ -109,6 +110,19 @@ class RunResult:
         return self.curves["a"]
 
 
+def work_increment(h0: float, h1: float, F0: float, F1: float) -> float:
+    """∫ F dh over [h0, h1] with F = C h^p through both end points (exact for power laws;
+    from h0 = 0 this is F1 h1/(p+1) with the Hertz exponent p = 3/2)."""
+    if F0 <= 0.0 or h0 <= 0.0:
+        return F1 * (h1 - h0) / 2.5
+    if F1 <= 0.0:
+        return 0.5 * (F0 + F1) * (h1 - h0)
+    p = np.log(F1 / F0) / np.log(h1 / h0)
+    if abs(p + 1.0) < 1e-9:
+        return F0 * h0 * np.log(h1 / h0)
+    return (F1 * h1 - F0 * h0) / (p + 1.0)
+
+
 class IndentationSolver:
     """Hemisphere (radius R, material) on a rigid obstacle; call ``run(h_max)``."""
 
@@ -135,6 +149,7 @@ class IndentationSolver:
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
         self._nd = nd
         self.line_search = "energy"
+        self.predictor = "secant"
 
     # ------------------------------------------------------------------ one Newton solve
     def _frame(self, active: np.ndarray, normal: np.ndarray):
@@ -310,13 +325,16 @@ class IndentationSolver:
         work = 0.0
         F_last = 0.0
         while h < h_max * (1 - 1e-12):
-            dh = min(dh, h_max - h, opt.dh_max * R)
+            a_last = hist.a_nodes[-1] if hist.a_nodes else 0.0
+            dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
             h_new = h + dh
             if u_prev is None:
                 u_pred = u.copy()
                 u_pred[1::2] -= dh  # rigid translation towards the obstacle
-            else:
+            elif self.predictor == "secant":
                 u_pred = u + (dh / dh_prev) * (u - u_prev)
+            else:
+                u_pred = u.copy()
             u_pred[2 * self.hmesh.equator + 1] = -h_new
             u_pred[2 * self.hmesh.axis] = 0.0
             try:
@@ -349,7 +367,7 @@ class IndentationSolver:
             areas = surface_areas(xa)[:-1]
             pressure = np.where(active, lam / areas, 0.0)
             a_nodes, a_sub, a_ref = contact_edge(self.X[0, self.surface], xs[0], gap, active)
-            work += 0.5 * (F + F_last) * dh
+            work += work_increment(h - dh, h, F_last, F)
             F_last = F
             hist.h.append(h)
             hist.F.append(F)
