@@ -44,7 +44,7 @@ class Discretisation:
         xq = basis.mapping.F(basis.X)  # (2, nel, nqp) reference coordinates of the points
         self.R_qp = xq[0]
         self.weights = (2.0 * np.pi * xq[0] * basis.dx).reshape(-1)  # (nel*nqp,)
-        phi = np.stack([basis.basis[i][0].value for i in range(nbf)])  # (nbf, nel, nqp)
+        phi = np.stack([np.asarray(basis.basis[i][0]) for i in range(nbf)])  # (nbf, nel, nqp)
         dphi = np.stack([basis.basis[i][0].grad for i in range(nbf)])  # (nbf, 2, nel, nqp)
         B = np.zeros((nel, nqp, 5, nbf, 2))
         B[:, :, 0, :, 0] = dphi[:, 0].transpose(1, 2, 0)  # ∂u_r/∂R

@@ -115,24 +115,23 @@ def smooth_contact_radius(h: np.ndarray, a_raw: np.ndarray, half_window: int = 3
     Nodal contact on quadratic edges makes the per-increment sub-element
     estimate alternate with the parity (corner/midside) of the outermost
     closed node: ±0.2 % rms scatter in a for an elastic sphere, while F(h) is
-    smooth to 0.02 %. Under monotone loading a(h) is smooth, so each a is
-    replaced by the value at its own h of a local quadratic least-squares fit of
-    a² against h over ``2 half_window + 1`` increments (fewer at the ends). No
-    increment with a = 0 is used or changed.
+    smooth to 0.02 %. Under monotone loading a(h) is smooth and locally a power
+    law (a ∝ h^½ in Hertz and in the self-similar plastic regime), so each a is
+    replaced by the value at its own h of a local straight-line least-squares
+    fit of ln a against ln h over ``2 half_window + 1`` increments (one-sided at
+    the ends). Increments with a = 0 are neither used nor changed.
     """
     h = np.asarray(h, dtype=float)
     a_raw = np.asarray(a_raw, dtype=float)
     out = a_raw.copy()
-    idx = np.flatnonzero(a_raw > 0)
-    if idx.size < 4:
-        return out
-    hh, aa2 = h[idx], a_raw[idx] ** 2
+    idx = np.flatnonzero((a_raw > 0) & (h > 0))
     n = idx.size
+    if n < 3:
+        return out
+    x, y = np.log(h[idx]), np.log(a_raw[idx])
     for j in range(n):
         lo = max(0, min(j - half_window, n - 2 * half_window - 1))
         hi = min(n, lo + 2 * half_window + 1)
-        x = hh[lo:hi] - hh[j]
-        deg = 2 if hi - lo >= 5 else 1
-        coef = np.polynomial.polynomial.polyfit(x, aa2[lo:hi], deg)
-        out[idx[j]] = np.sqrt(max(coef[0], 0.0))
+        slope, icpt = np.polyfit(x[lo:hi] - x[j], y[lo:hi], 1)
+        out[idx[j]] = np.exp(icpt)
     return out

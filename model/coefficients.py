@@ -48,7 +48,7 @@ LITERATURE: dict = {
     "schema_version": 1,
     "source": "literature",
     "provenance": {
-        "created": "2025-11-21",
+        "created": "2026-11-21",
         "method": "literature starting values, no fit to FE data",
         "fe_dataset": None,
         "notes": (
