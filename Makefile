@@ -19,6 +19,12 @@ test: $(STAMP)
 	$(PY) -m ruff check .
 	$(PY) -m pytest -q -m "not slow"
 
+demo: $(STAMP)
+	$(PY) -m spherecontact.demo --out reports/demo
+
+verify-fem: $(STAMP)
+	$(PY) -m spherecontact.fem.verification --out reports/fem
+
 bench: $(STAMP)
 	$(PY) -m bench.run_all
 

@@ -16,6 +16,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import numpy as np  # noqa: E402
+
 from spherecontact.model import Material, Sphere, contact  # noqa: E402
 from spherecontact.model.coefficients import default_coefficients  # noqa: E402
 from spherecontact.model.fast import ContactLaw  # noqa: E402

@@ -207,7 +207,8 @@ class IndentationSolver:
                 key = new_active.tobytes()
                 if not np.array_equal(new_active, active):
                     changes += 1
-                    if key in seen and np.count_nonzero(new_active != active) == 1:
+                    near = bool(res_hist) and res_hist[-1] < 1e-4
+                    if near and key in seen and np.count_nonzero(new_active != active) == 1:
                         # the edge node flips in and out (one node of contact resolution):
                         # keep it closed and finish the increment with that set
                         new_active = new_active | active
@@ -330,7 +331,8 @@ class IndentationSolver:
             h_new = h + dh
             if u_prev is None:
                 u_pred = u.copy()
-                u_pred[1::2] -= dh  # rigid translation towards the obstacle
+                # rigid translation by dh/2: its intersection radius √(R dh) is Hertz's a
+                u_pred[1::2] -= 0.5 * dh
             elif self.predictor == "secant":
                 u_pred = u + (dh / dh_prev) * (u - u_prev)
             else:

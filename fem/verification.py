@@ -281,7 +281,7 @@ def _report(figures: dict, pngs: list[str], outdir: Path, wall: float, quick: bo
              "| check | target | measured | pass |", "|---|---|---|---|",
              f"| Hertz F vs a (a/R 0.02–0.06, reference a) | ≤ 1 % | max {100 * h['F_vs_a_max_rel_err']:.2f} %, "
              f"mean {100 * h['F_vs_a_mean_rel_err']:+.2f} % | {h['pass']} |",
-             f"| Hertz F(h): finite sphere | a few % above Hertz | "
+             "| Hertz F(h): finite sphere | a few % above Hertz | "
              + ", ".join(f"h/R={k}: {100 * (v - 1):+.1f} %" for k, v in h["F_over_Hertz_at_h"].items())
              + " | — |"]
     for key, v in figures["jackson_green"].items():

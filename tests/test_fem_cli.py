@@ -5,12 +5,12 @@ import time
 
 import numpy as np
 import pytest
+
+from spherecontact.cli import main
 from spherecontact.fem import cli as fcli
 from spherecontact.fem import io as fio
 from spherecontact.fem import read_run
 from spherecontact.model.material import Material
-
-from spherecontact.cli import main
 
 TINY = ["--mesh-density", "0.25", "--dh-first", "1e-3", "--dh-max", "0.005", "--quiet"]
 EPP = ["--E", "200", "--nu", "0.3", "--sigma-y", "1", "--K", "0", "--n", "1"]

@@ -1,6 +1,5 @@
 """FE building blocks: tensor functions, return mapping, tangent, assembly, mesh, contact."""
 
-import math
 
 import numpy as np
 import pytest

@@ -7,12 +7,12 @@ import re
 import h5py
 import numpy as np
 import pytest
+
+import spherecontact
 from spherecontact.fem import io as fio
 from spherecontact.fem import read_run, run_indentation, write_run
 from spherecontact.fem.solver import RunResult, SolverOptions
 from spherecontact.model.material import Material
-
-import spherecontact
 
 EPP = Material(E=200.0, nu=0.3, sigma_y=1.0, K=0.0, n=1.0)
 TINY = SolverOptions(dh_first=1e-3, dh_max=0.005)

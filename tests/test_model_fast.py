@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 import pytest
+
 from spherecontact.model import Material, Sphere, contact
 from spherecontact.model.cli import curve, register
 from spherecontact.model.coefficients import LITERATURE, Coefficients

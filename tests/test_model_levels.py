@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+
 from spherecontact.model import levels
 from spherecontact.model.coefficients import (
     LITERATURE,

@@ -5,6 +5,7 @@ import math
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+
 from spherecontact.model import Material, Sphere, contact
 from spherecontact.model.coefficients import LITERATURE, Coefficients
 from spherecontact.model.unified import UnifiedPair

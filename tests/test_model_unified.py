@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+
 from spherecontact.model import Material, Sphere, contact, contact_from_radius
 from spherecontact.model.coefficients import LITERATURE, Coefficients
 from spherecontact.model.single import indent

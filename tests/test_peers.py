@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+
 from spherecontact.validation import peers
 
 R, E, NU, SY = 1e-3, 210e9, 0.3, 400e6

@@ -1,0 +1,107 @@
+"""End-to-end FE runs, short and coarse enough for CI (the full figures: fem/verification.py)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from spherecontact.fem.contact import RigidObstacle
+from spherecontact.fem.solver import IndentationSolver, SolverOptions
+from spherecontact.model import Material
+from spherecontact.validation.peers import jackson_green, jackson_green_critical
+
+E, NU = 200.0, 0.3
+EP = E / (1 - NU**2)
+
+
+@pytest.fixture(scope="module")
+def elastic_run():
+    solver = IndentationSolver(Material.elastic(E, NU), 1.0,
+                               options=SolverOptions(dh_first=1.5e-4, dh_max=1.5e-4))
+    return solver.run(0.003)
+
+
+def test_hertz_force_against_contact_radius(elastic_run):
+    """F = 4E'a³/(3R) (Hertz) with the reference-configuration contact radius."""
+    c = elastic_run.curves
+    inner = (np.arange(c["h"].size) >= 3) & (np.arange(c["h"].size) < c["h"].size - 3)
+    sel = (c["a_ref"] >= 0.02) & inner  # full smoothing window on both sides
+    assert sel.sum() >= 5
+    ratio = c["F"][sel] / (4 * EP * c["a_ref"][sel] ** 3 / 3)
+    assert np.abs(ratio - 1).max() < 0.01
+
+
+def test_finite_sphere_carries_more_than_hertz(elastic_run):
+    """DESIGN §2: a hemisphere loaded through its equator is stiffer than the half-space."""
+    c = elastic_run.curves
+    ratio = np.interp(0.002, c["h"], c["F"] / (4 / 3 * EP * c["h"] ** 1.5))
+    assert 1.01 < ratio < 1.035
+
+
+def test_deformed_radius_shrinks_by_hertz_radial_displacement(elastic_run):
+    c = elastic_run.curves
+    sel = c["a_ref"] >= 0.02
+    expected = -2 * (1 - 2 * NU) / (3 * math.pi * (1 - NU)) * c["a_ref"][sel]
+    assert np.abs(c["a"][sel] / c["a_ref"][sel] - 1 - expected).max() < 5e-4
+
+
+def test_equilibrium_and_newton_rate(elastic_run):
+    c = elastic_run.curves
+    assert np.allclose(c["F_support"], c["F"], rtol=1e-7)
+    assert elastic_run.status == "converged" and c["h"][-1] == pytest.approx(0.003)
+    # quadratic convergence: the last step squares the residual (up to a constant)
+    rates = [math.log(r[-1]) / math.log(r[-2]) for r in elastic_run.residuals
+             if len(r) >= 3 and 1e-12 < r[-2] < 1e-3]
+    assert rates and np.median(rates) > 1.6
+
+
+def test_rigid_sphere_indenter_is_hertz_with_effective_radius():
+    R2 = 1.0
+    solver = IndentationSolver(Material.elastic(E, NU), 1.0, RigidObstacle(R2),
+                               options=SolverOptions(dh_first=2.5e-4, dh_max=2.5e-4))
+    c = solver.run(0.002).curves
+    R_star = 1.0 * R2 / (1.0 + R2)
+    sel = c["a_ref"] >= 0.015
+    ratio = c["F"][sel] / (4 * EP * c["a_ref"][sel] ** 3 / (3 * R_star))
+    assert np.abs(ratio - 1).max() < 0.02
+    assert np.allclose(c["F_support"], c["F"], rtol=1e-7)
+
+
+def test_plastic_run_against_jackson_green_and_energy():
+    mat = Material(E=E, nu=NU, sigma_y=1.0)
+    omega_c = jackson_green_critical(1.0, EP, 1.0, NU)[0]
+    solver = IndentationSolver(mat, 1.0, density=0.5, options=SolverOptions(dh_first=2e-5, dh_max=2e-4))
+    res = solver.run(30 * omega_c)
+    c = res.curves
+    jg = jackson_green(c["h"], 1.0, EP, 1.0, NU)
+    late = c["h"] > 5 * omega_c
+    assert np.abs(c["F"][late] / jg.F[late] - 1).max() < 0.06  # the fit's own scatter is a few %
+    assert c["eps_p_max"][-1] > 0.01 and c["dissipation"][-1] > 0
+    balance = (c["energy_elastic"] + c["dissipation"]) / c["work_external"] - 1
+    assert abs(balance[-1]) < 0.015
+
+
+def test_run_that_cannot_converge_stops_and_keeps_its_converged_part():
+    """Two Newton iterations are too few once plasticity starts: the run must stop
+    with its reason, the converged increments kept, and no exception."""
+    opts = SolverOptions(dh_first=1e-4, dh_max=1e-4, dh_min=5e-5, max_iterations=2)
+    solver = IndentationSolver(Material(E=E, nu=NU, sigma_y=1.0), 1.0, density=0.5, options=opts)
+    res = solver.run(0.01)
+    assert res.status == "stopped"
+    assert "dh_min" in res.reason and "h/R" in res.reason
+    assert res.h.size < 100 and (res.h.size == 0 or res.h[-1] < 0.01)
+    assert len(res.residuals) == res.h.size
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(h_max=0.0), "h_max"), (dict(h_max=-1.0), "h_max"), (dict(h_max=2.0), "h_max"),
+])
+def test_bad_h_max(kwargs, match):
+    solver = IndentationSolver(Material.elastic(E, NU), 1.0, density=0.5)
+    with pytest.raises(ValueError, match=match):
+        solver.run(**kwargs)
+
+
+def test_rigid_body_is_rejected():
+    with pytest.raises(ValueError, match="rigid"):
+        IndentationSolver(Material.rigid(), 1.0)
