@@ -291,7 +291,7 @@ class IndentationSolver:
                 return trial
             new = lo + (alpha - lo) * s_lo / (s_lo - s_a)
             alpha = float(np.clip(new, 0.1 * alpha, alpha))
-        return u + alpha * du
+        return trial  # the last admissible step tried
 
     def _admissible(self, u, du, halvings: int = 6, with_alpha: bool = False, base_alpha: float = 1.0):
         """u + β du with the largest β = 2^-k keeping every Jacobian positive."""
@@ -409,7 +409,8 @@ class IndentationSolver:
         prof_p = np.array(hist.profile_p).reshape(-1, nsurf)
         prof_g = np.array(hist.profile_g).reshape(-1, nsurf)
         timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
-                   "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum())}
+                   "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum()),
+                   "rejected_increments": len(self.rejected)}
         final = {"X": self.X, "u": u, "cells": self.disc.basis.element_dofs.T.copy(),
                  "eps_p": state.eps_p.reshape(self.disc.n_elements, self.disc.n_qp)}
         inputs = {"material": self.material.describe(), "radius": R,
