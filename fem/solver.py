@@ -45,12 +45,15 @@ class SolverOptions:
     max_iterations: int = 25
     tol: float = 1e-8  # ‖free residual‖∞ ≤ tol · largest reaction
     strain_increment: float = 0.01  # dh ≤ strain_increment · a: bounds the strain per step
+    max_wall_s: float = float("inf")  # stop (status "stopped", converged part kept) after this
 
     def validate(self) -> None:
         for name in ("dh_first", "dh_max", "dh_min", "tol", "strain_increment"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        if not self.max_wall_s > 0:
+            raise ValueError(f"max_wall_s must be > 0 (inf: no limit), got {self.max_wall_s!r}")
         if self.dh_min > self.dh_first or self.dh_first > self.dh_max:
             raise ValueError("increments must satisfy dh_min <= dh_first <= dh_max")
         if not self.growth >= 1.0:
@@ -150,6 +153,7 @@ class IndentationSolver:
         self._nd = nd
         self.line_search = "energy"
         self.predictor = "secant"
+        self.ls_accept = 0.5
 
     # ------------------------------------------------------------------ one Newton solve
     def _frame(self, active: np.ndarray, normal: np.ndarray):
@@ -183,6 +187,7 @@ class IndentationSolver:
         seen = set()
         changes = 0
         frozen = False
+        flips = 0
         for it in range(opt.max_iterations):
             t0 = time.perf_counter()
             Fv = disc.deformation_gradient(u)
@@ -207,8 +212,10 @@ class IndentationSolver:
                 key = new_active.tobytes()
                 if not np.array_equal(new_active, active):
                     changes += 1
+                    flip = key in seen and np.count_nonzero(new_active != active) == 1
+                    flips += flip
                     near = bool(res_hist) and res_hist[-1] < 1e-4
-                    if near and key in seen and np.count_nonzero(new_active != active) == 1:
+                    if flip and (near or flips >= 3):
                         # the edge node flips in and out (one node of contact resolution):
                         # keep it closed and finish the increment with that set
                         new_active = new_active | active
@@ -285,7 +292,7 @@ class IndentationSolver:
             f = self.disc.internal_force(stress_update(Fv, state.cp_inv, state.eps_p, self.material).P)
             r = T.T @ f if T is not None else f
             s_a = float(np.dot(duf, r[free]))
-            if abs(s_a) <= 0.5 * abs(s0):
+            if abs(s_a) <= self.ls_accept * abs(s0):
                 return trial
             if s_a < 0.0:  # still descending: the zero lies beyond α
                 return trial
@@ -326,6 +333,10 @@ class IndentationSolver:
         work = 0.0
         F_last = 0.0
         while h < h_max * (1 - 1e-12):
+            if time.perf_counter() - t_start > opt.max_wall_s:
+                status = "stopped"
+                reason = f"wall-time limit of {opt.max_wall_s:g} s reached at h/R = {h / R:.6g}"
+                break
             a_last = hist.a_nodes[-1] if hist.a_nodes else 0.0
             dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
             h_new = h + dh

@@ -27,7 +27,7 @@ import json
 import math
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -40,13 +40,23 @@ NU = 0.3
 
 
 def _run(kind: str, E_over_sy: float, h_max: float, density: float = 1.0, element: str = "q8r",
-         K: float = 0.0, n: float = 1.0, options: dict | None = None) -> dict:
+         K: float = 0.0, n: float = 1.0, options: dict | None = None, name: str = "run",
+         log_dir: str | None = None) -> dict:
     """One FE run (σ_Y = 1, R = 1); returns curves, residual histories and timings."""
     mat = Material.elastic(E_over_sy, NU) if kind == "elastic" else Material(
         E=E_over_sy, nu=NU, sigma_y=1.0, K=K, n=n)
     solver = IndentationSolver(mat, 1.0, RigidObstacle(), density=density, element=element,
                                options=SolverOptions(**(options or {})))
-    res = solver.run(h_max)
+    log = open(Path(log_dir) / f"progress_{name}.log", "w") if log_dir else None
+
+    def progress(h):
+        if log:
+            print(f"{time.perf_counter() - t0:8.1f} s  h/R = {h:.5f}", file=log, flush=True)
+
+    t0 = time.perf_counter()
+    res = solver.run(h_max, progress=progress)
+    if log:
+        log.close()
     return {"curves": {k: v.tolist() for k, v in res.curves.items()}, "status": res.status,
             "reason": res.reason, "timings": res.timings,
             "residuals": [list(map(float, r)) for r in res.residuals],
@@ -89,10 +99,11 @@ def plan(quick: bool) -> dict:
                              options=dict(dh_first=2e-5, dh_max=1e-4)),
     }
     if not quick:
+        limit = dict(max_wall_s=1200.0)
         runs.update({
-            "large_epp50": dict(kind="epp", E_over_sy=50.0, h_max=0.5),
-            "large_epp500": dict(kind="epp", E_over_sy=500.0, h_max=0.5),
-            "large_ludwik": dict(kind="ludwik", E_over_sy=200.0, h_max=0.5, K=2.0, n=0.3),
+            "large_epp50": dict(kind="epp", E_over_sy=50.0, h_max=0.5, options=limit),
+            "large_epp500": dict(kind="epp", E_over_sy=500.0, h_max=0.5, options=limit),
+            "large_ludwik": dict(kind="ludwik", E_over_sy=200.0, h_max=0.5, K=2.0, n=0.3, options=limit),
         })
     return runs
 
@@ -330,17 +341,24 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.setdefault(var, "1")
     t0 = time.perf_counter()
     cases = plan(args.quick)
-    order = sorted(cases, key=lambda k: -cases[k]["h_max"] * cases[k].get("density", 1.0) ** 2)
+    order = sorted(cases, key=lambda k: cases[k]["h_max"] * cases[k].get("density", 1.0) ** 2)
     from tqdm import tqdm
 
     raw = outdir / "runs.json"
     runs = json.loads(raw.read_text()) if args.reuse and raw.exists() else {}
     todo = [k for k in order if k not in runs]
+    failed: dict[str, str] = {}
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        futures = {k: pool.submit(_run, **cases[k]) for k in todo}
-        for k in tqdm(todo, desc="FE verification runs", unit="run"):
-            runs[k] = futures[k].result()
+        futures = {pool.submit(_run, **cases[k], name=k, log_dir=str(outdir)): k for k in todo}
+        for fut in tqdm(as_completed(futures), total=len(futures), desc="FE verification runs", unit="run"):
+            try:
+                runs[futures[fut]] = fut.result()
+            except Exception as err:  # keep the other runs; the report names the failure
+                failed[futures[fut]] = f"{type(err).__name__}: {err}"
+                continue
             raw.write_text(json.dumps(runs))
+    if failed:
+        raise SystemExit(f"verification runs failed: {failed}")
     figures = evaluate(runs, args.quick)
     pngs = _plots(runs, figures, outdir)
     wall = time.perf_counter() - t0

@@ -105,3 +105,23 @@ def test_bad_h_max(kwargs, match):
 def test_rigid_body_is_rejected():
     with pytest.raises(ValueError, match="rigid"):
         IndentationSolver(Material.rigid(), 1.0)
+
+
+def test_default_options_are_valid_and_bad_ones_are_named():
+    from spherecontact.fem.solver import SolverOptions
+
+    SolverOptions().validate()
+    with pytest.raises(ValueError, match="max_wall_s"):
+        SolverOptions(max_wall_s=0.0).validate()
+    with pytest.raises(ValueError, match="strain_increment"):
+        SolverOptions(strain_increment=-1.0).validate()
+
+
+def test_wall_time_limit_stops_with_reason_and_keeps_increments():
+    from spherecontact.fem.solver import SolverOptions
+
+    solver = IndentationSolver(Material.elastic(E, NU), 1.0, density=0.5,
+                               options=SolverOptions(dh_first=1e-4, dh_max=1e-4, max_wall_s=1.0))
+    res = solver.run(0.5)
+    assert res.status == "stopped" and "wall-time" in res.reason
+    assert 0 < res.h[-1] < 0.5 and res.h.size == len(res.residuals)
