@@ -38,8 +38,8 @@ class Discretisation:
         self.basis = basis
         nbf, nel = basis.Nbfun, basis.nelems
         nqp = basis.X.shape[1]
-        self.n_nodes = basis.N
-        self.n_dofs = 2 * basis.N
+        self.n_nodes = int(basis.N)
+        self.n_dofs = 2 * self.n_nodes
         self.n_elements, self.n_qp = nel, nqp
         xq = basis.mapping.F(basis.X)  # (2, nel, nqp) reference coordinates of the points
         self.R_qp = xq[0]

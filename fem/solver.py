@@ -29,6 +29,10 @@ from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 
 
+#: nodal-force roundoff of the stress update, in units of E R² (see ``_newton``)
+ROUNDOFF = 1e-16
+
+
 class IncrementFailed(RuntimeError):
     """Newton did not converge in one increment (the increment is retried smaller)."""
 
@@ -250,6 +254,9 @@ class IndentationSolver:
                 [-gap[active & ~self.on_axis], -gap[active & self.on_axis]])
             ref = max(np.abs(r[fixed]).max(), 1e-300)
             res = float(np.abs(r[free]).max()) / ref
+            # roundoff floor: F = I + ∇u carries strains next to 1, so stresses carry an
+            # absolute error ~1e-16 E and nodal forces ~1e-16 E R² (matters at h ≲ 1e-5 R)
+            floor = ROUNDOFF * mat.E * R**2 / ref
             res_hist.append(res)
             t3 = time.perf_counter()
             self.timers["constitutive"] += t1 - t0
@@ -257,7 +264,7 @@ class IndentationSolver:
             self.timers["contact"] += t3 - t2
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            if not changed and res <= opt.tol and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
+            if not changed and res <= max(opt.tol, floor) and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
                 return u, upd, active, it, changes, res_hist, f, gap
             Kff = K[free][:, free]
             rhs = -r[free] - K[free][:, ~free] @ du_c[~free]

@@ -57,10 +57,15 @@ def _run(kind: str, E_over_sy: float, h_max: float, density: float = 1.0, elemen
     res = solver.run(h_max, progress=progress)
     if log:
         log.close()
-    return {"curves": {k: v.tolist() for k, v in res.curves.items()}, "status": res.status,
-            "reason": res.reason, "timings": res.timings,
-            "residuals": [list(map(float, r)) for r in res.residuals],
-            "n_dofs": solver.disc.n_dofs, "rejected": len(solver.rejected)}
+    out = {"curves": {k: v.tolist() for k, v in res.curves.items()}, "status": res.status,
+           "reason": res.reason, "timings": {k: float(v) for k, v in res.timings.items()},
+           "residuals": [list(map(float, r)) for r in res.residuals],
+           "n_dofs": int(solver.disc.n_dofs), "rejected": len(solver.rejected)}
+    if log_dir:  # each run saves itself: nothing finished is lost if the caller fails
+        tmp = Path(log_dir) / f".run_{name}.json.tmp"
+        tmp.write_text(json.dumps(out))
+        os.replace(tmp, Path(log_dir) / f"run_{name}.json")
+    return out
 
 
 def _at(run: dict, key: str, h: float) -> float:
@@ -333,7 +338,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="coarser, shorter runs (CI)")
     parser.add_argument("--out", default="reports/fem", help="output directory")
     parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--reuse", action="store_true", help="reuse finished runs from OUT/runs.json")
+    parser.add_argument("--reuse", action="store_true", help="reuse finished runs (OUT/run_*.json)")
     args = parser.parse_args(argv)
     outdir = Path(args.out)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -344,8 +349,12 @@ def main(argv: list[str] | None = None) -> int:
     order = sorted(cases, key=lambda k: cases[k]["h_max"] * cases[k].get("density", 1.0) ** 2)
     from tqdm import tqdm
 
-    raw = outdir / "runs.json"
-    runs = json.loads(raw.read_text()) if args.reuse and raw.exists() else {}
+    runs = {}
+    if args.reuse:
+        for k in order:
+            f = outdir / f"run_{k}.json"
+            if f.exists():
+                runs[k] = json.loads(f.read_text())
     todo = [k for k in order if k not in runs]
     failed: dict[str, str] = {}
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
@@ -355,8 +364,6 @@ def main(argv: list[str] | None = None) -> int:
                 runs[futures[fut]] = fut.result()
             except Exception as err:  # keep the other runs; the report names the failure
                 failed[futures[fut]] = f"{type(err).__name__}: {err}"
-                continue
-            raw.write_text(json.dumps(runs))
     if failed:
         raise SystemExit(f"verification runs failed: {failed}")
     figures = evaluate(runs, args.quick)
