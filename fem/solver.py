@@ -28,7 +28,6 @@ from .contact import RigidObstacle, contact_edge, smooth_contact_radius, surface
 from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 
-
 #: nodal-force roundoff of the stress update, in units of E R² (see ``_newton``)
 ROUNDOFF = 1e-16
 
