@@ -47,7 +47,7 @@ class SolverOptions:
     easy_iterations: int = 7  # grow the increment after at most this many iterations
     max_iterations: int = 25
     tol: float = 1e-8  # ‖free residual‖∞ ≤ tol · largest reaction
-    strain_increment: float = 0.01  # dh ≤ strain_increment · a: bounds the strain per step
+    strain_increment: float = 0.005  # dh ≤ strain_increment · a: bounds the strain per step
     max_wall_s: float = float("inf")  # stop (status "stopped", converged part kept) after this
 
     def validate(self) -> None:

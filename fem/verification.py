@@ -93,7 +93,7 @@ def plan(quick: bool) -> dict:
         "standard": dict(kind="epp", E_over_sy=200.0, h_max=h_std),
         "standard_fine": dict(kind="epp", E_over_sy=200.0, h_max=h_std, density=d2),
         "standard_dt2": dict(kind="epp", E_over_sy=200.0, h_max=h_std,
-                             options=dict(strain_increment=0.005)),
+                             options=dict(strain_increment=0.0025)),
         "lock_q8r": dict(kind="epp", E_over_sy=1e4, h_max=0.0012,
                          options=dict(dh_first=2e-5, dh_max=1e-4)),
         "lock_q8r_fine": dict(kind="epp", E_over_sy=1e4, h_max=0.0012, density=d2,
