@@ -49,6 +49,7 @@ class SolverOptions:
     tol: float = 1e-8  # ‖free residual‖∞ ≤ tol · largest reaction
     strain_increment: float = 0.005  # dh ≤ strain_increment · a: bounds the strain per step
     max_wall_s: float = float("inf")  # stop (status "stopped", converged part kept) after this
+    line_search: bool = True  # energy line search (off: full Newton steps, J > 0 guard only)
 
     def validate(self) -> None:
         for name in ("dh_first", "dh_max", "dh_min", "tol", "strain_increment"):
@@ -154,9 +155,6 @@ class IndentationSolver:
         self.n_points = self.disc.n_elements * self.disc.n_qp
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
         self._nd = nd
-        self.line_search = "energy"
-        self.predictor = "secant"
-        self.ls_accept = 0.5
 
     # ------------------------------------------------------------------ one Newton solve
     def _frame(self, active: np.ndarray, normal: np.ndarray):
@@ -285,7 +283,7 @@ class IndentationSolver:
         α = 1 is taken when |s(1)| ≤ ½|s(0)|, otherwise α moves to the secant zero
         of s (clipped to [0.1, 1]). Steps that would invert an element are halved.
         """
-        if self.line_search == "none":
+        if not self.options.line_search:
             return self._admissible(u, du)
         duf = (T.T @ du)[free] if T is not None else du[free]
         s0 = float(np.dot(duf, r0))
@@ -298,7 +296,7 @@ class IndentationSolver:
             f = self.disc.internal_force(stress_update(Fv, state.cp_inv, state.eps_p, self.material).P)
             r = T.T @ f if T is not None else f
             s_a = float(np.dot(duf, r[free]))
-            if abs(s_a) <= self.ls_accept * abs(s0):
+            if abs(s_a) <= 0.5 * abs(s0):
                 return trial
             if s_a < 0.0:  # still descending: the zero lies beyond α
                 return trial
@@ -350,10 +348,8 @@ class IndentationSolver:
                 u_pred = u.copy()
                 # rigid translation by dh/2: its intersection radius √(R dh) is Hertz's a
                 u_pred[1::2] -= 0.5 * dh
-            elif self.predictor == "secant":
+            else:  # secant predictor
                 u_pred = u + (dh / dh_prev) * (u - u_prev)
-            else:
-                u_pred = u.copy()
             u_pred[2 * self.hmesh.equator + 1] = -h_new
             u_pred[2 * self.hmesh.axis] = 0.0
             try:
