@@ -77,9 +77,12 @@ def material_from_args(args: argparse.Namespace) -> Material:
 
 
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
-    """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol."""
+    """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
+    --strain-increment, --max-wall-s and --no-line-search."""
     return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
-                         max_iterations=args.max_iterations, tol=args.tol)
+                         max_iterations=args.max_iterations, tol=args.tol,
+                         strain_increment=args.strain_increment, max_wall_s=args.max_wall_s,
+                         line_search=not args.no_line_search)
 
 
 def _check_output(out) -> Path:
@@ -196,6 +199,14 @@ def _add_numerics(add) -> None:
     add(grp, "--tol", type=float, default=_DEFAULTS.tol,
         help="Newton tolerance: largest free residual / largest reaction, > 0 "
              f"(default {_DEFAULTS.tol:g})")
+    add(grp, "--strain-increment", type=float, default=_DEFAULTS.strain_increment,
+        help="bound on the strain per increment, dh <= strain-increment * a, > 0 "
+             f"(default {_DEFAULTS.strain_increment:g})")
+    add(grp, "--max-wall-s", type=float, default=_DEFAULTS.max_wall_s,
+        help="stop after this many seconds, > 0; the converged part is written with "
+             "status 'stopped' (default inf: no limit)")
+    add(grp, "--no-line-search", action="store_true",
+        help="full Newton steps (only the J > 0 guard); the default uses an energy line search")
 
 
 def _add_output(add) -> None:

@@ -162,3 +162,17 @@ def test_help_describes_every_option(argv, capsys):
         assert opt in text, opt
     for rng in ("(-1, 0.5)", "(0, 0.8 R]", "[0.25, 4]", "[2, 200]", "unit of --radius"):
         assert rng in text, rng
+
+
+def test_solver_option_flags_reach_the_options():
+    from spherecontact.cli import build_parser
+    from spherecontact.fem.cli import options_from_args
+
+    args = build_parser().parse_args([
+        "fem", "run", "--E", "200", "--h-max", "0.1", "--out", "x.h5", "--strain-increment", "0.002",
+        "--max-wall-s", "10", "--no-line-search"])
+    opts = options_from_args(args)
+    assert opts.strain_increment == 0.002 and opts.max_wall_s == 10.0 and opts.line_search is False
+    default = options_from_args(build_parser().parse_args(
+        ["fem", "run", "--E", "200", "--h-max", "0.1", "--out", "x.h5"]))
+    assert default.line_search is True and default.max_wall_s == float("inf")
