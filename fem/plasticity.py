@@ -210,9 +210,13 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None)
                         tau=np.stack([t11, t12, t22, ttt]))
 
 
-def stress_and_tangent(F, state: PlasticState, material: Material):
-    """Stress update at real F (shape (5, N)) and the tangent A[i, k] = ∂P_i/∂F_k, (5, 5, N)."""
-    real = stress_update(F, state.cp_inv, state.eps_p, material)
+def stress_and_tangent(F, state: PlasticState, material: Material, real: StressUpdate | None = None):
+    """Stress update at real F (shape (5, N)) and the tangent A[i, k] = ∂P_i/∂F_k, (5, 5, N).
+
+    ``real``: the real stress update at this F when the caller already has it.
+    """
+    if real is None:
+        real = stress_update(F, state.cp_inv, state.eps_p, material)
     Fc = F[:, None, :] + 1j * CSTEP * np.eye(5)[:, :, None]
     cplx = stress_update(Fc, state.cp_inv[:, None, :], state.eps_p[None, :], material,
                          dgamma=real.dgamma[None, :])

@@ -189,14 +189,19 @@ class IndentationSolver:
         changes = 0
         frozen = False
         flips = 0
+        known = None  # (F, real stress update, internal force) at u from the line search
         for it in range(opt.max_iterations):
             t0 = time.perf_counter()
-            Fv = disc.deformation_gradient(u)
-            if np.any(Fv[0] * Fv[3] - Fv[1] * Fv[2] <= 0) or np.any(Fv[4] <= 0):
-                raise IncrementFailed("inverted element (J <= 0)")
-            upd, A = stress_and_tangent(Fv, state, mat)
+            if known is None:
+                Fv = disc.deformation_gradient(u)
+                if np.any(Fv[0] * Fv[3] - Fv[1] * Fv[2] <= 0) or np.any(Fv[4] <= 0):
+                    raise IncrementFailed("inverted element (J <= 0)")
+                upd, A = stress_and_tangent(Fv, state, mat)
+                f = disc.internal_force(upd.P)
+            else:
+                Fv, real, f = known
+                upd, A = stress_and_tangent(Fv, state, mat, real=real)
             t1 = time.perf_counter()
-            f = disc.internal_force(upd.P)
             K = disc.tangent(A)
             t2 = time.perf_counter()
             us = np.stack([u[2 * self.surface], u[2 * self.surface + 1]])
@@ -271,7 +276,7 @@ class IndentationSolver:
             du[free] = lu.solve(rhs)
             if T is not None:
                 du = T @ du
-            u = self._line_search(u, du, free, T, state, r[free])
+            u, known = self._line_search(u, du, free, T, state, r[free])
             self.timers["solve"] += time.perf_counter() - t3
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {res_hist[-1]:.2e})")
@@ -282,27 +287,31 @@ class IndentationSolver:
         s(α) = du_f · r_f(u + α du) is the slope of the potential along the step;
         α = 1 is taken when |s(1)| ≤ ½|s(0)|, otherwise α moves to the secant zero
         of s (clipped to [0.1, 1]). Steps that would invert an element are halved.
+        Returns the new u and, when the accepted step was evaluated, its
+        (F, real stress update, internal force) for the next iteration.
         """
         if not self.options.line_search:
-            return self._admissible(u, du)
+            return self._admissible(u, du), None
         duf = (T.T @ du)[free] if T is not None else du[free]
         s0 = float(np.dot(duf, r0))
         if s0 >= 0.0:
-            return self._admissible(u, du)
+            return self._admissible(u, du), None
         alpha, lo, s_lo = 1.0, 0.0, s0
         for _ in range(max_steps):
             trial, alpha = self._admissible(u, alpha * du, with_alpha=True, base_alpha=alpha)
             Fv = self.disc.deformation_gradient(trial)
-            f = self.disc.internal_force(stress_update(Fv, state.cp_inv, state.eps_p, self.material).P)
+            real = stress_update(Fv, state.cp_inv, state.eps_p, self.material)
+            f = self.disc.internal_force(real.P)
+            known = (Fv, real, f)
             r = T.T @ f if T is not None else f
             s_a = float(np.dot(duf, r[free]))
             if abs(s_a) <= 0.5 * abs(s0):
-                return trial
+                return trial, known
             if s_a < 0.0:  # still descending: the zero lies beyond α
-                return trial
+                return trial, known
             new = lo + (alpha - lo) * s_lo / (s_lo - s_a)
             alpha = float(np.clip(new, 0.1 * alpha, alpha))
-        return trial  # the last admissible step tried
+        return trial, known  # the last admissible step tried
 
     def _admissible(self, u, du, halvings: int = 6, with_alpha: bool = False, base_alpha: float = 1.0):
         """u + β du with the largest β = 2^-k keeping every Jacobian positive."""
