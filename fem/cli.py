@@ -24,7 +24,7 @@ from .io import check_inputs, run_indentation, write_run
 from .mesh import DENSITY_RANGE
 from .solver import SolverOptions
 
-__all__ = ["register", "run_command", "read_flow_table", "material_from_args",
+__all__ = ["register", "run_command", "render_command", "read_flow_table", "material_from_args",
            "options_from_args", "EXIT_STOPPED"]
 
 #: exit code of a run that stopped before h_max (file written, status "stopped")
@@ -253,8 +253,37 @@ def _option_table(listed, width: int = 79) -> str:
     return "\n".join(lines)
 
 
+def _build_render_parser(cmds) -> None:
+    rp = cmds.add_parser(
+        "render", help="final fields of a run file: VTU for ParaView and/or a PNG of plastic strain",
+        description="Write the final deformed section of RUN with its displacement and equivalent "
+                    "plastic strain to a VTU file (ParaView, via meshio) and/or render the plastic "
+                    "strain off-screen to a PNG (needs pyvista: pip install '.[render]').")
+    rp.add_argument("run", metavar="RUN", help="HDF5 run file written by 'fem run'")
+    rp.add_argument("--png", metavar="FILE.png", help="picture of the equivalent plastic strain")
+    rp.add_argument("--vtu", metavar="FILE.vtu", help="mesh and fields for ParaView")
+    rp.add_argument("--reference", action="store_true",
+                    help="write the VTU on the undeformed section (default: deformed)")
+    rp.set_defaults(func=render_command)
+
+
+def render_command(args: argparse.Namespace) -> int:
+    """``fem render``: VTU and/or PNG of a run's final state; at least one output."""
+    from .io import read_run
+    from .render import export_vtu, render_png
+
+    if not (args.png or args.vtu):
+        raise ValueError("fem render: give --png FILE.png and/or --vtu FILE.vtu")
+    run = read_run(args.run)
+    if args.vtu:
+        print(f"wrote {export_vtu(run, args.vtu, deformed=not args.reference)}")
+    if args.png:
+        print(f"wrote {render_png(run, args.png)}")
+    return 0
+
+
 def register(subparsers) -> None:
-    """Add the ``fem`` stage and its ``run`` command to the top-level parser."""
+    """Add the ``fem`` stage and its ``run`` and ``render`` commands to the top-level parser."""
     fem = subparsers.add_parser(
         "fem", help="FE reference solver (one hemisphere on a rigid flat or sphere)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -264,6 +293,7 @@ def register(subparsers) -> None:
                     "(read it back with spherecontact.fem.read_run).")
     cmds = fem.add_subparsers(dest="command", required=True, metavar="COMMAND")
     listed = _build_run_parser(cmds)
+    _build_render_parser(cmds)
     fem.epilog = ("options of 'fem run' (lengths in the unit of --radius, stresses in the "
                   "unit of --E):\n" + _option_table(listed)
                   + "\n\nExit codes of 'fem run': 0 reached h-max; 2 bad input; 3 stopped early.")
