@@ -76,7 +76,6 @@ class History:
     a: list = field(default_factory=list)
     a_nodes: list = field(default_factory=list)
     a_ref: list = field(default_factory=list)
-    p_m: list = field(default_factory=list)
     eps_p_max: list = field(default_factory=list)
     work_external: list = field(default_factory=list)
     energy_elastic: list = field(default_factory=list)
@@ -156,6 +155,11 @@ class IndentationSolver:
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
         self._nd = nd
 
+    @staticmethod
+    def _nodal(v: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+        """(2, n) r and z components of an interleaved nodal vector at ``nodes``."""
+        return np.stack([v[2 * nodes], v[2 * nodes + 1]])
+
     # ------------------------------------------------------------------ one Newton solve
     def _frame(self, active: np.ndarray, normal: np.ndarray):
         """Nodal rotation T (u = T ũ) for active off-axis nodes on a curved obstacle,
@@ -204,10 +208,8 @@ class IndentationSolver:
             t1 = time.perf_counter()
             K = disc.tangent(A)
             t2 = time.perf_counter()
-            us = np.stack([u[2 * self.surface], u[2 * self.surface + 1]])
-            gap, normal, curv = self.obstacle.gap_normal(Xs + us)
-            fs = np.stack([f[2 * self.surface], f[2 * self.surface + 1]])
-            lam = np.einsum("ci,ci->i", fs, normal)
+            gap, normal, curv = self.obstacle.gap_normal(Xs + self._nodal(u, self.surface))
+            lam = np.einsum("ci,ci->i", self._nodal(f, self.surface), normal)
             if not frozen:
                 wants = np.where(active, lam > 0.0, gap < -1e-12 * R)
                 # the contact of a sphere on a flat or sphere is a disc: close every node up to
@@ -267,7 +269,7 @@ class IndentationSolver:
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
             if not changed and res <= max(opt.tol, floor) and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
-                return u, upd, active, it, changes, res_hist, f, gap
+                return u, upd, active, it, changes, res_hist, f, gap, np.where(active, lam, 0.0), normal
             Kff = K[free][:, free]
             rhs = -r[free] - K[free][:, ~free] @ du_c[~free]
             lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A",
@@ -362,7 +364,7 @@ class IndentationSolver:
             u_pred[2 * self.hmesh.equator + 1] = -h_new
             u_pred[2 * self.hmesh.axis] = 0.0
             try:
-                u_new, upd, act, its, changes, res_hist, f, gap = self._newton(
+                u_new, upd, act, its, changes, res_hist, f, gap, lam, normal = self._newton(
                     u_pred, h_new, state, active.copy())
             except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
                 self.rejected.append((h_new, dh, str(err)))
@@ -382,13 +384,9 @@ class IndentationSolver:
             u_prev, u, dh_prev, active = u, u_new, dh, act
             h = h_new
             F_support = -float(f[2 * self.hmesh.equator + 1].sum())
-            xs = self.X[:, self.surface] + np.stack([u[2 * self.surface], u[2 * self.surface + 1]])
-            _, normal, _ = self.obstacle.gap_normal(xs)
-            lam = np.where(active, np.einsum("ci,ci->i", np.stack(
-                [f[2 * self.surface], f[2 * self.surface + 1]]), normal), 0.0)
+            xs = self.X[:, self.surface] + self._nodal(u, self.surface)
             F = float(np.sum(lam * normal[1]))
-            xa = self.X[:, self.arc] + np.stack([u[2 * self.arc], u[2 * self.arc + 1]])
-            areas = surface_areas(xa)[:-1]
+            areas = surface_areas(self.X[:, self.arc] + self._nodal(u, self.arc))[:-1]
             pressure = np.where(active, lam / areas, 0.0)
             a_nodes, a_sub, a_ref = contact_edge(self.X[0, self.surface], xs[0], gap, active)
             work += work_increment(h - dh, h, F_last, F)
@@ -399,7 +397,6 @@ class IndentationSolver:
             hist.a.append(a_sub)
             hist.a_nodes.append(a_nodes)
             hist.a_ref.append(a_ref)
-            hist.p_m.append(F / (np.pi * a_sub**2) if a_sub > 0 else 0.0)
             hist.eps_p_max.append(float(state.eps_p.max()))
             hist.work_external.append(work)
             hist.energy_elastic.append(self.disc.integrate(upd.psi))
@@ -416,7 +413,7 @@ class IndentationSolver:
                 dh *= opt.growth
         wall = time.perf_counter() - t_start
         curves = {k: np.asarray(getattr(hist, k), dtype=float) for k in (
-            "h", "F", "F_support", "a", "a_nodes", "a_ref", "p_m", "eps_p_max", "work_external",
+            "h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max", "work_external",
             "energy_elastic", "dissipation", "iterations", "active_changes")}
         # a: sub-element estimates smoothed over increments; the raw ones are kept
         curves["a_raw"], curves["a_ref_raw"] = curves["a"], curves["a_ref"]
