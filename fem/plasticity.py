@@ -102,10 +102,10 @@ def solve_plastic_multiplier(q_tr, eps_p_n, material: Material, mu: float, tol=1
     The residual is strictly decreasing in Δγ; the root lies in [0, q_tr/(3μ)].
     """
     q_tr = np.asarray(q_tr, dtype=float)
-    lo = np.zeros_like(q_tr)
-    hi = q_tr / (3.0 * mu)
     if not material.is_tabulated and material.K == 0.0:
         return (q_tr - material.sigma_y) / (3.0 * mu)  # perfectly plastic: closed form
+    lo = np.zeros_like(q_tr)
+    hi = q_tr / (3.0 * mu)
     x = np.zeros_like(q_tr)
     scale = material.sigma_y
     for _ in range(maxit):
