@@ -1,0 +1,484 @@
+"""Incremental Newton solver: two deformable hemispheres pressed together (DESIGN §4).
+
+Scene: body 1 (radius R₁) above, pole at the origin, equatorial plane z = R₁
+moved down by the total approach h; body 2 (radius R₂) below, pole at the
+origin, equatorial plane z = −R₂ fixed; both free to slide radially on their
+equatorial planes, u_r = 0 on the axis. Body 2 is meshed in its own mirrored
+frame (z → −z); the mirror enters only the contact terms.
+
+Contact is frictionless node-to-surface (``segments.py``): the surface nodes
+of the slave body (the smaller sphere; body 1 on a tie) against the C¹
+(Catmull–Rom) curve through the master's surface nodes, with one Lagrange multiplier per active slave node and the
+consistent second derivative of the gap, so Newton stays quadratic through
+large sliding of the interface. No penalty number. Each iteration solves the
+saddle-point system
+
+    [ K − Σ λ_i ∂²g_i    −Gᵀ ] [ Δu ]   = − [ f_int ]
+    [ −G                  0  ] [ λ  ]       [ −g    ]
+
+on the free dofs (G = ∂g/∂u of the active nodes), with the primal–dual active
+set and the energy line search of the one-body solver (``solver.py``).
+Outputs the one-body curves plus h₁, h₂ (shortening of each body's
+equator-to-pole distance), the interface curvature at the axis and the plastic
+dissipation of each body.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..model.material import Material
+from .assembly import Discretisation
+from .contact import contact_edge, smooth_contact_radius, surface_areas
+from .mesh import build_mesh
+from .plasticity import PlasticState, stress_and_tangent, stress_update
+from .segments import N_COORDS, gap_gradient, gap_hessian
+from .solver import ROUNDOFF, IncrementFailed, RunResult, SolverOptions, work_increment
+
+#: |g| of active nodes at convergence, relative to the smaller radius
+GAP_TOL = 1e-12
+
+
+@dataclass
+class Body:
+    """One hemisphere: mesh, discretisation, material and where its dofs sit."""
+
+    material: Material
+    radius: float
+    disc: Discretisation
+    offset: int  # first global dof
+    mirror: bool  # meshed in the frame z → −z (body 2)
+
+    @property
+    def hmesh(self):
+        return self.disc.hmesh
+
+    @property
+    def n_dofs(self) -> int:
+        return self.disc.n_dofs
+
+    @property
+    def zsign(self) -> float:
+        return -1.0 if self.mirror else 1.0
+
+    def local(self, u: np.ndarray) -> np.ndarray:
+        """This body's slice of the global dof vector."""
+        return u[self.offset:self.offset + self.n_dofs]
+
+    def positions(self, u: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+        """Current physical positions (2, n) of ``nodes`` for the global vector ``u``."""
+        ul = self.local(u)
+        X = self.hmesh.X[:, nodes]
+        return np.stack([X[0] + ul[2 * nodes], self.zsign * (X[1] + ul[2 * nodes + 1])])
+
+
+class TwoBodySolver:
+    """Two elastic–plastic hemispheres on one axis; call ``run(h_max)`` (h = h₁ + h₂)."""
+
+    def __init__(self, material1: Material, radius1: float, material2: Material, radius2: float,
+                 density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None):
+        if material1.is_rigid or material2.is_rigid:
+            raise ValueError("both bodies of the two-body scene must be deformable (finite E)")
+        self.options = options or SolverOptions()
+        self.options.validate()
+        t0 = time.perf_counter()
+        discs = [Discretisation(build_mesh(R, density, linear=(element == "q4")), element)
+                 for R in (radius1, radius2)]
+        self.t_setup = time.perf_counter() - t0
+        self.bodies = [Body(material1, float(radius1), discs[0], 0, False),
+                       Body(material2, float(radius2), discs[1], discs[0].n_dofs, True)]
+        self.n_dofs = sum(b.n_dofs for b in self.bodies)
+        self.R = min(radius1, radius2)
+        # the slave is the smaller sphere (finer surface mesh where the contact is)
+        self.slave_index = 1 if radius2 < radius1 else 0
+        self.slave = self.bodies[self.slave_index]
+        self.master = self.bodies[1 - self.slave_index]
+        self.candidates = self.slave.hmesh.surface[:-1]  # slave contact nodes, from the pole
+        self.master_arc = self.master.hmesh.surface  # corners at even, midsides at odd positions
+        self.ctrl_nodes, self.ctrl_rsign = self._control_points()
+        # outward normal of the master: up for body 2 (below), down for body 1 (above)
+        self.side = 1.0 if self.master.mirror else -1.0
+        self.on_axis = np.isin(self.candidates, self.slave.hmesh.axis)
+        fixed = []
+        for b in self.bodies:
+            fixed += [b.offset + 2 * b.hmesh.equator + 1, b.offset + 2 * b.hmesh.axis]
+        self.fixed = np.unique(np.concatenate(fixed))
+        self.free = np.ones(self.n_dofs, dtype=bool)
+        self.free[self.fixed] = False
+        self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+
+    # ------------------------------------------------------------------ contact kinematics
+    def _control_points(self):
+        """Master node and r-sign of the 4 control points of every interval (4, n_int).
+
+        Interval j joins arc nodes j and j+1; before the pole the mirror image of
+        the first node off the axis is used (the surface of revolution is smooth
+        there). The last interval (at the equator) is never a contact candidate.
+        """
+        arc = self.master_arc
+        j = np.arange(arc.size - 2)
+        pos = np.stack([j - 1, j, j + 1, j + 2])
+        rsign = np.where(pos < 0, -1.0, 1.0)
+        return arc[np.abs(pos)], rsign
+
+    def _pairs(self, u: np.ndarray):
+        """Master interval of every slave candidate and the 10 gap coordinates per pair."""
+        xs = self.slave.positions(u, self.candidates)
+        xm = self.master.positions(u, self.master_arc)
+        d2 = (xs[0][:, None] - xm[0][None]) ** 2 + (xs[1][:, None] - xm[1][None]) ** 2
+        k = np.argmin(d2, axis=1)
+        last = self.ctrl_nodes.shape[1] - 1
+        best, best_excess = None, None
+        for seg in (np.clip(k - 1, 0, last), np.clip(k, 0, last)):  # the interval holding t
+            coords = self._coords(u, seg)
+            t = gap_gradient(coords, self.side)[2]
+            excess = np.maximum(np.maximum(-t, t - 1.0), 0.0)
+            if best is None:
+                best, best_excess = seg, excess
+            else:
+                better = excess < best_excess
+                best = np.where(better, seg, best)
+                best_excess = np.minimum(excess, best_excess)
+        return best, self._coords(u, best)
+
+    def _coords(self, u, seg):
+        """(10, n): slave candidate positions and the control points of intervals ``seg``."""
+        xs = self.slave.positions(u, self.candidates)
+        nodes, rsign = self.ctrl_nodes[:, seg], self.ctrl_rsign[:, seg]
+        P = self.master.positions(u, nodes.ravel()).reshape(2, 4, -1)
+        P[0] *= rsign
+        return np.concatenate([xs, P.transpose(1, 0, 2).reshape(8, -1)])
+
+    def _dofs_and_signs(self, seg: np.ndarray, rows: np.ndarray):
+        """Global dofs (10, n) and coordinate signs (10, n) of the pairs ``rows``."""
+        s, m = self.slave, self.master
+        nodes = [self.candidates[rows]] + [self.ctrl_nodes[k, seg[rows]] for k in range(4)]
+        rsigns = [np.ones(rows.size)] + [self.ctrl_rsign[k, seg[rows]] for k in range(4)]
+        bodies = [s, m, m, m, m]
+        dofs = np.concatenate([np.stack([b.offset + 2 * nd, b.offset + 2 * nd + 1])
+                               for b, nd in zip(bodies, nodes, strict=True)])
+        signs = np.concatenate([np.stack([rs, np.full(rows.size, b.zsign)])
+                                for b, rs in zip(bodies, rsigns, strict=True)])
+        return dofs, signs
+
+    def _contact(self, u: np.ndarray, active: np.ndarray, lam: np.ndarray, hessian: bool):
+        """Gaps of all candidates; G (n_active × n_dofs), Gᵀλ and −Σ λ ∂²g for the active set."""
+        seg, coords = self._pairs(u)
+        gap, grad, _, normal = gap_gradient(coords, self.side)
+        rows = np.flatnonzero(active)
+        dofs, signs = self._dofs_and_signs(seg, rows)
+        gl = grad[:, rows] * signs
+        G = sp.csr_matrix((gl.T.ravel(), (np.repeat(np.arange(rows.size), N_COORDS), dofs.T.ravel())),
+                          shape=(rows.size, self.n_dofs))
+        Gt_lam = np.bincount(dofs.ravel(), weights=(gl * lam[rows]).ravel(), minlength=self.n_dofs)
+        Kc = None
+        if hessian and rows.size:
+            H = gap_hessian(coords[:, rows], self.side) * signs[:, None, :] * signs[None, :, :]
+            vals = -(H * lam[rows]).ravel()
+            r_idx = np.repeat(dofs[:, None, :], N_COORDS, axis=1).ravel()
+            c_idx = np.repeat(dofs[None, :, :], N_COORDS, axis=0).ravel()
+            Kc = sp.csr_matrix((vals, (r_idx, c_idx)), shape=(self.n_dofs,) * 2)
+        return gap, normal, G, Gt_lam, Kc
+
+    # ------------------------------------------------------------------ bodies
+    def _stress(self, u, states, known=None):
+        """Per body (F, stress update, tangent A) and the global internal force."""
+        out, f = [], np.zeros(self.n_dofs)
+        for i, (b, st) in enumerate(zip(self.bodies, states, strict=True)):
+            if known is None:
+                Fv = b.disc.deformation_gradient(b.local(u))
+                if np.any(Fv[0] * Fv[3] - Fv[1] * Fv[2] <= 0) or np.any(Fv[4] <= 0):
+                    raise IncrementFailed(f"inverted element (J <= 0) in body {i + 1}")
+                upd, A = stress_and_tangent(Fv, st, b.material)
+                fb = b.disc.internal_force(upd.P)
+            else:
+                Fv, real, fb = known[i]
+                upd, A = stress_and_tangent(Fv, st, b.material, real=real)
+            f[b.offset:b.offset + b.n_dofs] = fb
+            out.append((Fv, upd, A))
+        return out, f
+
+    def _jacobians_positive(self, u) -> bool:
+        for b in self.bodies:
+            Fv = b.disc.deformation_gradient(b.local(u))
+            if not (np.all(Fv[0] * Fv[3] - Fv[1] * Fv[2] > 0) and np.all(Fv[4] > 0)):
+                return False
+        return True
+
+    # ------------------------------------------------------------------ one Newton solve
+    def _update_active(self, active, lam, gap, log):
+        """Primal–dual active set kept a disc, with the edge-flip freeze of the one-body solver."""
+        wants = np.where(active, lam > 0.0, gap < -GAP_TOL * self.R)
+        new = np.zeros_like(active)
+        if wants.any():
+            new[: np.flatnonzero(wants).max() + 1] = True
+        if np.array_equal(new, active):
+            return active, False
+        log["changes"] += 1
+        key = new.tobytes()
+        flip = key in log["seen"] and np.count_nonzero(new != active) == 1
+        log["flips"] += flip
+        near = bool(log["res"]) and log["res"][-1] < 1e-4
+        if flip and (near or log["flips"] >= 3):
+            new = new | active
+            log["frozen"] = True
+        log["seen"].add(key)
+        return new, not np.array_equal(new, active)
+
+    def _newton(self, u, states, active, lam):
+        opt = self.options
+        nd, free = self.n_dofs, self.free
+        scale = max(b.material.E * b.radius for b in self.bodies)  # λ = scale · μ
+        log = {"changes": 0, "flips": 0, "frozen": False, "seen": set(), "res": []}
+        known = None
+        for it in range(opt.max_iterations):
+            t0 = time.perf_counter()
+            per_body, f = self._stress(u, states, known)
+            t1 = time.perf_counter()
+            K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body,
+                                                                            strict=True)], format="csr")
+            t2 = time.perf_counter()
+            gap, normal, G, Gt_lam, Kc = self._contact(u, active, lam, hessian=False)
+            changed = False
+            if not log["frozen"]:
+                active, changed = self._update_active(active, lam, gap, log)
+                lam = np.where(active, lam, 0.0)
+                if changed:
+                    gap, normal, G, Gt_lam, Kc = self._contact(u, active, lam, hessian=False)
+            r = f - Gt_lam
+            ref = max(np.abs(r[~free]).max(), np.abs(Gt_lam).max(), 1e-300)
+            res = float(np.abs(r[free]).max()) / ref
+            floor = ROUNDOFF * max(b.material.E for b in self.bodies) * self.R**2 / ref
+            gap_err = float(np.abs(gap[active]).max(initial=0.0))
+            log["res"].append(res)
+            if not np.isfinite(res) or res > 1e6:
+                raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
+            self.timers["constitutive"] += t1 - t0
+            self.timers["assembly"] += t2 - t1
+            if not changed and res <= max(opt.tol, floor) and gap_err <= GAP_TOL * self.R:
+                return u, per_body, f, active, lam, gap, normal, it, log
+            _, _, G, _, Kc = self._contact(u, active, lam, hessian=True)
+            t3 = time.perf_counter()
+            self.timers["contact"] += t3 - t2
+            if Kc is not None:
+                K = K + Kc
+            Gf = G[:, free]
+            n_act = G.shape[0]
+            system = sp.bmat([[K[free][:, free], -scale * Gf.T],
+                              [-scale * Gf, sp.csr_matrix((n_act, n_act))]], format="csc")
+            rhs = np.concatenate([-f[free], scale * gap[active]])
+            sol = spla.splu(system, permc_spec="COLAMD").solve(rhs)
+            du = np.zeros(nd)
+            du[free] = sol[:free.sum()]
+            lam = np.zeros_like(lam)
+            lam[active] = scale * sol[free.sum():]
+            u, known = self._line_search(u, du, f, states, active, lam)
+            self.timers["solve"] += time.perf_counter() - t3
+        raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
+                              f"(last relative residual {log['res'][-1]:.2e})")
+
+    def _line_search(self, u, du, f0, states, active, lam, max_steps: int = 4):
+        """Energy line search on the Lagrangian with the new multipliers fixed (cf. solver.py)."""
+        free = self.free
+        duf = du[free]
+
+        def slope(trial):
+            known, f = [], np.zeros(self.n_dofs)
+            for b, st in zip(self.bodies, states, strict=True):
+                Fv = b.disc.deformation_gradient(b.local(trial))
+                real = stress_update(Fv, st.cp_inv, st.eps_p, b.material)
+                fb = b.disc.internal_force(real.P)
+                f[b.offset:b.offset + b.n_dofs] = fb
+                known.append((Fv, real, fb))
+            Gt_lam = self._contact(trial, active, lam, hessian=False)[3]
+            return float(np.dot(duf, (f - Gt_lam)[free])), known
+
+        beta = 1.0
+        while not self._jacobians_positive(u + beta * du):
+            beta *= 0.5
+            if beta < 2**-6:
+                raise IncrementFailed("inverted element (J <= 0) even after step halving")
+        du = beta * du
+        if not self.options.line_search:
+            return u + du, None
+        s0 = float(np.dot(duf, (f0 - self._contact(u, active, lam, hessian=False)[3])[free]))
+        if s0 >= 0.0:
+            return u + du, None
+        alpha, lo, s_lo = 1.0, 0.0, s0
+        for _ in range(max_steps):
+            trial = u + alpha * du
+            s_a, known = slope(trial)
+            if abs(s_a) <= 0.5 * abs(s0) or s_a < 0.0:
+                return trial, known
+            alpha = float(np.clip(lo + (alpha - lo) * s_lo / (s_lo - s_a), 0.1 * alpha, alpha))
+        return trial, known
+
+    # ------------------------------------------------------------------ the incremental run
+    def _predictor(self, h_new, dh):
+        """Rigid translations towards each other by dh/2 in total, split as Hertz's h₁/h₂."""
+        e1, e2 = (b.material.E_prime for b in self.bodies)
+        w1 = e2 / (e1 + e2)
+        u = np.zeros(self.n_dofs)
+        b1, b2 = self.bodies
+        u[b1.offset + 1:b1.offset + b1.n_dofs:2] = -0.5 * dh * w1
+        u[b2.offset + 1:b2.offset + b2.n_dofs:2] = -0.5 * dh * (1.0 - w1)  # mirrored frame
+        return u
+
+    def _apply_bc(self, u, h):
+        b1, b2 = self.bodies
+        u[b1.offset + 2 * b1.hmesh.equator + 1] = -h
+        u[b2.offset + 2 * b2.hmesh.equator + 1] = 0.0
+        for b in self.bodies:
+            u[b.offset + 2 * b.hmesh.axis] = 0.0
+        return u
+
+    def _pole_shortening(self, u, h):
+        """(h₁, h₂): shortening of each body's equator-to-pole distance."""
+        b1, b2 = self.bodies
+        p1, p2 = b1.hmesh.surface[0], b2.hmesh.surface[0]
+        return h + b1.local(u)[2 * p1 + 1], b2.local(u)[2 * p2 + 1]
+
+    def _interface_curvature(self, xs, a):
+        """κ of z = z₀ + κ r²/2 fitted to the deformed interface within r ≤ a/2 (body 1 convex: κ > 0)."""
+        inner = xs[0] <= 0.5 * a
+        if np.count_nonzero(inner) < 3:
+            return np.nan
+        coef = np.polyfit(xs[0][inner] ** 2, xs[1][inner], 1)
+        return 2.0 * coef[0]
+
+    def run(self, h_max: float, progress=None) -> RunResult:
+        """Press the bodies together to the total approach ``h_max`` (h₁ + h₂)."""
+        R, opt = self.R, self.options
+        h_max = float(h_max)
+        if not (np.isfinite(h_max) and 0 < h_max <= 0.8 * R):
+            raise ValueError(f"h_max must lie in (0, 0.8 min(R1, R2)] = (0, {0.8 * R:g}], got {h_max!r}")
+        t_start = time.perf_counter()
+        for k in self.timers:
+            self.timers[k] = 0.0
+        self.rejected = []
+        u = np.zeros(self.n_dofs)
+        u_prev = None
+        states = [PlasticState.virgin(b.disc.n_elements * b.disc.n_qp) for b in self.bodies]
+        active = np.zeros(self.candidates.size, dtype=bool)
+        lam = np.zeros(self.candidates.size)
+        rec = {k: [] for k in ("h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max",
+                               "work_external", "energy_elastic", "dissipation", "iterations",
+                               "active_changes", "h1", "h2", "interface_curvature", "dissipation_1",
+                               "dissipation_2", "eps_p_max_1", "eps_p_max_2")}
+        residuals, prof_r, prof_p, prof_g = [], [], [], []
+        h, dh, dh_prev = 0.0, opt.dh_first * R, None
+        status, reason = "converged", "reached h_max"
+        work, F_last = 0.0, 0.0
+        s = self.slave
+        while h < h_max * (1 - 1e-12):
+            if time.perf_counter() - t_start > opt.max_wall_s:
+                status = "stopped"
+                reason = f"wall-time limit of {opt.max_wall_s:g} s reached at h/R_min = {h / R:.6g}"
+                break
+            a_last = rec["a_nodes"][-1] if rec["a_nodes"] else 0.0
+            dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
+            h_new = h + dh
+            u_pred = self._predictor(h_new, dh) if u_prev is None else u + (dh / dh_prev) * (u - u_prev)
+            u_pred = self._apply_bc(u_pred, h_new)
+            try:
+                u_new, per_body, f, act, lam_new, gap, normal, its, log = self._newton(
+                    u_pred, states, active.copy(), lam.copy())
+            except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
+                self.rejected.append((h_new, dh, str(err)))
+                dh *= 0.5
+                if dh < opt.dh_min * R:
+                    status = "stopped"
+                    reason = f"increment below dh_min = {opt.dh_min:g} R_min at h/R_min = {h / R:.6g}: {err}"
+                    break
+                continue
+            # ---- commit
+            new_states, diss = [], []
+            for b, st, (_, upd, _) in zip(self.bodies, states, per_body, strict=True):
+                dg = upd.dgamma
+                inc = b.disc.integrate(np.where(dg > 0, b.material.flow_stress(st.eps_p + dg) * dg, 0.0)
+                                       if np.isfinite(b.material.sigma_y) else np.zeros_like(dg))
+                new_states.append(PlasticState(upd.cp_inv, upd.eps_p, st.dissipation + inc))
+                diss.append(st.dissipation + inc)
+            states = new_states
+            u_prev, u, dh_prev, active, lam = u, u_new, dh, act, lam_new
+            h = h_new
+            b1, b2 = self.bodies
+            F_support = -float(f[b1.offset + 2 * b1.hmesh.equator + 1].sum())
+            F = abs(float(np.sum(lam * normal[1])))
+            xs = s.positions(u, self.candidates)
+            arc = s.hmesh.surface
+            areas = surface_areas(s.positions(u, arc))[:-1]
+            pressure = np.where(active, lam / areas, 0.0)
+            a_nodes, a_sub, a_ref = contact_edge(s.hmesh.X[0, self.candidates], xs[0], gap, active)
+            work += work_increment(h - dh, h, F_last, F)
+            F_last = F
+            h1, h2 = self._pole_shortening(u, h)
+            for key, val in (("h", h), ("F", F), ("F_support", F_support), ("a", a_sub),
+                             ("a_nodes", a_nodes), ("a_ref", a_ref),
+                             ("eps_p_max", max(float(st.eps_p.max()) for st in states)),
+                             ("work_external", work),
+                             ("energy_elastic", sum(b.disc.integrate(upd.psi) for b, (_, upd, _)
+                                                    in zip(self.bodies, per_body, strict=True))),
+                             ("dissipation", diss[0] + diss[1]), ("iterations", its),
+                             ("active_changes", log["changes"]), ("h1", h1), ("h2", h2),
+                             ("interface_curvature", self._interface_curvature(xs, a_sub)),
+                             ("dissipation_1", diss[0]), ("dissipation_2", diss[1]),
+                             ("eps_p_max_1", float(states[0].eps_p.max())),
+                             ("eps_p_max_2", float(states[1].eps_p.max()))):
+                rec[key].append(val)
+            residuals.append(log["res"])
+            prof_r.append(xs[0].copy())
+            prof_p.append(pressure)
+            prof_g.append(np.where(active, 0.0, gap))
+            if progress is not None:
+                progress(h)
+            if its <= opt.easy_iterations:
+                dh *= opt.growth
+        return self._result(rec, residuals, prof_r, prof_p, prof_g, status, reason, u, states,
+                            h_max, time.perf_counter() - t_start)
+
+    def _result(self, rec, residuals, prof_r, prof_p, prof_g, status, reason, u, states, h_max, wall):
+        curves = {k: np.asarray(v, dtype=float) for k, v in rec.items()}
+        curves["a_raw"], curves["a_ref_raw"] = curves["a"], curves["a_ref"]
+        curves["a"] = smooth_contact_radius(curves["h"], curves["a_raw"])
+        curves["a_ref"] = smooth_contact_radius(curves["h"], curves["a_ref_raw"])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            curves["p_m"] = np.where(curves["a"] > 0, curves["F"] / (np.pi * curves["a"] ** 2), 0.0)
+        for k in ("iterations", "active_changes"):
+            curves[k] = curves[k].astype(int)
+        n = self.candidates.size
+        timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
+                   "increments": int(curves["h"].size), "newton_iterations": int(curves["iterations"].sum()),
+                   "rejected_increments": len(self.rejected)}
+        b1, b2 = self.bodies
+        inputs = {"scene": "two_body", "material": b1.material.describe(), "radius": b1.radius,
+                  "material2": b2.material.describe(), "radius2": b2.radius,
+                  "indenter_radius": b2.radius, "h_max": h_max,
+                  "mesh_density": b1.hmesh.density, "element": b1.disc.element,
+                  "n_elements": b1.disc.n_elements + b2.disc.n_elements, "n_dofs": self.n_dofs,
+                  "slave_body": self.slave_index + 1, "options": dict(vars(self.options))}
+        return RunResult(inputs=inputs, curves=curves, residuals=residuals,
+                         profile_r=np.array(prof_r).reshape(-1, n), profile_p=np.array(prof_p).reshape(-1, n),
+                         profile_g=np.array(prof_g).reshape(-1, n), status=status, reason=reason,
+                         timings=timings, final=self._final(u, states))
+
+    def _final(self, u, states) -> dict:
+        """Both sections in physical coordinates as one mesh (body 2 mirrored, cells re-oriented)."""
+        b1, b2 = self.bodies
+        n1 = b1.hmesh.n_nodes
+        X2 = b2.hmesh.X * np.array([[1.0], [-1.0]])
+        u2 = b2.local(u).reshape(-1, 2) * np.array([1.0, -1.0])
+        c1 = b1.disc.basis.element_dofs.T
+        c2 = b2.disc.basis.element_dofs.T
+        flip = [0, 3, 2, 1, 7, 6, 5, 4] if c2.shape[1] == 8 else [0, 3, 2, 1]
+        return {"X": np.concatenate([b1.hmesh.X, X2], axis=1),
+                "u": np.concatenate([b1.local(u), u2.ravel()]),
+                "cells": np.concatenate([c1, c2[:, flip] + n1]),
+                "eps_p": np.concatenate([st.eps_p.reshape(b.disc.n_elements, b.disc.n_qp)
+                                         for b, st in zip(self.bodies, states, strict=True)]),
+                "body": np.concatenate([np.full(b1.disc.n_elements, 1), np.full(b2.disc.n_elements, 2)])}
