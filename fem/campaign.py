@@ -1,0 +1,341 @@
+"""Run an FE campaign into the reference database, in parallel, resumable.
+
+``python -m spherecontact.fem.campaign --campaign data/campaign.toml --db data/reference.h5``
+
+The campaign file (:mod:`.design`) expands to cases; cases whose key is already
+in the database are skipped (``--retry-failed`` / ``--retry-stopped`` rerun
+those). The rest run in local worker processes (``--workers``, default: one per
+core) or on a Dask cluster (``--scheduler tcp://host:port``). Workers send the
+``RunResult`` back; the main process is the only writer and appends each run
+as it finishes (:func:`spherecontact.data.append_run`, crash-safe), so a killed
+campaign loses at most the runs in flight. A run that raises is recorded under
+``failed/`` with its reason and traceback; one that stops early (wall-time
+limit, increment below dh_min) is stored with status ``stopped``. At the end a
+table per set (converged / stopped / failed / missing, wall time) is printed and
+written to ``<db>.summary.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import sys
+import time
+import traceback as _traceback
+from collections.abc import Callable, Iterator
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from multiprocessing import get_context
+from pathlib import Path
+
+from ..data import Database, Record, append_run, remove_stale_temporaries
+from .design import Campaign, Case, load_campaign
+from .io import provenance, run_indentation
+from .solver import RunResult
+
+__all__ = ["Outcome", "execute", "plan", "run_campaign", "summarize", "format_summary", "main"]
+
+#: thread counts of the numerical libraries in local workers (one core per run)
+THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+ENTRY_POINT = "spherecontact.fem.campaign"
+
+
+# ============================================================================ one case
+@dataclass
+class Outcome:
+    """What a worker sends back: the result (None if the run raised), reason, traceback."""
+
+    key: str
+    status: str  # "converged" | "stopped" | "failed"
+    reason: str
+    wall_s: float
+    result: RunResult | None = None
+    provenance: dict | None = None
+    traceback: str = ""
+
+
+def execute(case: Case) -> Outcome:
+    """Run one case (in a worker); every exception becomes a failed Outcome."""
+    t0 = time.perf_counter()
+    try:
+        result = run_indentation(**case.run_kwargs())
+        prov = provenance(result, extra={"entry_point": ENTRY_POINT, "set": case.set,
+                                         "case": case.name})
+        return Outcome(case.key, result.status, result.reason,
+                       float(result.timings.get("wall_s", time.perf_counter() - t0)), result, prov)
+    except Exception as err:  # recorded, never raised: one bad case must not stop the campaign
+        return Outcome(case.key, "failed", f"{type(err).__name__}: {err}", time.perf_counter() - t0,
+                       traceback=_traceback.format_exc())
+
+
+def _lost(case: Case, err: BaseException) -> Outcome:
+    """Outcome of a case whose worker died or could not run it."""
+    return Outcome(case.key, "failed", f"worker error: {type(err).__name__}: {err}", 0.0,
+                   traceback="".join(_traceback.format_exception(err)))
+
+
+# ============================================================================ executors
+Runner = Callable[[Case], Outcome]
+
+
+def _inline(cases: list[Case], runner: Runner) -> Iterator[tuple[Case, Outcome]]:
+    """Run in this process, one after the other (``--workers 0``)."""
+    for case in cases:
+        yield case, runner(case)
+
+
+def _local(cases: list[Case], runner: Runner, workers: int) -> Iterator[tuple[Case, Outcome]]:
+    """Local worker processes (spawned, one numerical thread each); results as they finish."""
+    saved = {v: os.environ.get(v) for v in THREAD_VARS}
+    os.environ.update({v: "1" for v in THREAD_VARS})  # inherited by the spawned workers
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
+    try:
+        pending = {pool.submit(runner, case): case for case in cases}
+        while pending:
+            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in done:
+                case = pending.pop(fut)
+                err = fut.exception()
+                yield case, (_lost(case, err) if err is not None else fut.result())
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+        for var, value in saved.items():
+            if value is None:
+                os.environ.pop(var, None)
+            else:
+                os.environ[var] = value
+
+
+def _dask(cases: list[Case], runner: Runner, scheduler: str) -> Iterator[tuple[Case, Outcome]]:
+    """A Dask cluster at ``scheduler``; results as they finish."""
+    try:
+        from dask.distributed import Client, as_completed
+    except ImportError:
+        raise ValueError("--scheduler needs dask.distributed: pip install 'spherecontact[campaign]'") \
+            from None
+    try:
+        client = Client(scheduler, timeout="30s")
+    except (OSError, TimeoutError) as err:
+        raise ValueError(f"--scheduler {scheduler}: cannot connect: {err}") from None
+    try:
+        futures = {client.submit(runner, case, pure=False): case for case in cases}
+        for fut in as_completed(list(futures)):
+            case = futures.pop(fut)
+            try:
+                outcome = fut.result()
+            except Exception as err:  # the task died with its worker
+                outcome = _lost(case, err)
+            fut.release()
+            yield case, outcome
+    finally:
+        client.close()
+
+
+# ============================================================================ planning
+def _state(db: Database | None, key: str) -> str:
+    """Database status of ``key``, or ``"missing"``."""
+    return db.record(key).status if db is not None and key in db else "missing"
+
+
+def plan(cases: list[Case], db: Database | None, retry_failed: bool = False,
+         retry_stopped: bool = False) -> list[Case]:
+    """The cases to run: missing ones, plus failed / stopped ones when asked to retry."""
+    rerun = {"missing"} | ({"failed"} if retry_failed else set()) | ({"stopped"} if retry_stopped else set())
+    return [c for c in cases if _state(db, c.key) in rerun]
+
+
+def _open_db(path: Path) -> Database | None:
+    return Database(path) if path.exists() else None
+
+
+# ============================================================================ summary
+def summarize(campaign: Campaign, cases: list[Case], db_path, elapsed_s: float, ran: int,
+              backend: str) -> dict:
+    """Per-set counts (converged / stopped / failed / missing) and wall times of ``cases``."""
+    db = _open_db(Path(db_path))
+    sets: dict = {}
+    for case in cases:
+        s = sets.setdefault(case.set, {"cases": 0, "converged": 0, "stopped": 0, "failed": 0,
+                                       "missing": 0, "wall_s_total": 0.0})
+        s["cases"] += 1
+        state = _state(db, case.key)
+        s[state] += 1
+        if state != "missing":
+            s["wall_s_total"] += db.record(case.key).wall_s
+    total = {k: sum(s[k] for s in sets.values()) for k in
+             ("cases", "converged", "stopped", "failed", "missing", "wall_s_total")}
+    for s in [*sets.values(), total]:
+        done = s["cases"] - s["missing"]
+        s["wall_s_mean"] = s["wall_s_total"] / done if done else None
+    known = {c.key for c in campaign.cases}
+    return {"database": str(db_path), "campaign": campaign.source,
+            "date_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "backend": backend, "ran": ran, "elapsed_s": elapsed_s, "sets": sets, "total": total,
+            "entries_not_in_campaign": 0 if db is None else sum(k not in known for k in db),
+            "content_hash": None if db is None else db.content_hash}
+
+
+def format_summary(summary: dict) -> str:
+    """The summary as a text table (one row per set and a total)."""
+    head = (f"{'set':<14}{'cases':>6}{'converged':>10}{'stopped':>8}{'failed':>7}{'missing':>8}"
+            f"{'wall total [s]':>16}{'wall/run [s]':>14}")
+    rows = [head, "-" * len(head)]
+    for name, s in [*summary["sets"].items(), ("total", summary["total"])]:
+        mean = "-" if s["wall_s_mean"] is None else f"{s['wall_s_mean']:.1f}"
+        rows.append(f"{name:<14}{s['cases']:>6}{s['converged']:>10}{s['stopped']:>8}{s['failed']:>7}"
+                    f"{s['missing']:>8}{s['wall_s_total']:>16.1f}{mean:>14}")
+    rows.append(f"this invocation: {summary['ran']} runs in {summary['elapsed_s']:.1f} s "
+                f"({summary['backend']})")
+    return "\n".join(rows)
+
+
+def _write_json(path: Path, data: dict) -> None:
+    """Write JSON atomically (temporary sibling, then rename)."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(json.dumps(data, indent=2) + "\n")
+    os.replace(tmp, path)
+
+
+# ============================================================================ running
+def _log(bar, text: str) -> None:
+    """One line per finished run, above the progress bar (or plain when the bar is off)."""
+    if bar.disable:
+        print(text, file=sys.stderr, flush=True)
+    else:
+        bar.write(text, file=sys.stderr)
+
+
+def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = None,
+                 workers: int | None = None, scheduler: str | None = None,
+                 retry_failed: bool = False, retry_stopped: bool = False,
+                 runner: Runner = execute) -> dict:
+    """Run the selected cases not yet in the database; return the summary (also written as JSON).
+
+    ``workers = 0`` runs in this process; ``scheduler`` a Dask cluster instead of
+    local processes. ``runner(case) -> Outcome`` executes one case (must be
+    importable by the workers).
+    """
+    from tqdm import tqdm
+
+    db_path = Path(db_path)
+    if not db_path.parent.is_dir():
+        raise ValueError(f"--db: directory {db_path.parent} does not exist")
+    remove_stale_temporaries(db_path)
+    selected = campaign.select(sets, only)
+    db = _open_db(db_path)
+    todo = plan(selected, db, retry_failed, retry_stopped)
+    workers = (os.cpu_count() or 1) if workers is None else workers
+    backend = f"dask {scheduler}" if scheduler else (
+        "in-process" if workers == 0 else f"{workers} local worker process(es)")
+    print(f"{len(selected)} cases selected, {len(selected) - len(todo)} already in {db_path}, "
+          f"{len(todo)} to run on {backend}", file=sys.stderr, flush=True)
+    t0 = time.perf_counter()
+    if todo:
+        if scheduler:
+            stream = _dask(todo, runner, scheduler)
+        elif workers == 0:
+            stream = _inline(todo, runner)
+        else:
+            stream = _local(todo, runner, min(workers, len(todo)))
+        bar = tqdm(total=len(todo), unit="run", desc="fem campaign", file=sys.stderr,
+                   disable=not sys.stderr.isatty(), smoothing=0.1)
+        try:
+            for done, (case, out) in enumerate(stream, start=1):
+                present = _state(db, case.key)
+                record = Record(key=case.key, set=case.set, case=case.name, status=out.status,
+                                reason=out.reason, wall_s=out.wall_s, inputs=case.inputs,
+                                params=case.params)
+                append_run(db_path, record, out.result, out.provenance, traceback=out.traceback,
+                           campaign_text=campaign.text, campaign_source=campaign.source,
+                           replace=present == "stopped")
+                bar.update(1)
+                _log(bar, f"[{done}/{len(todo)}] {case.set} {case.name}: {out.status} "
+                          f"({out.wall_s:.1f} s){'' if out.status == 'converged' else ': ' + out.reason}")
+        finally:
+            bar.close()
+            stream.close()
+    summary = summarize(campaign, selected, db_path, time.perf_counter() - t0, len(todo), backend)
+    if db_path.exists():
+        _write_json(Path(f"{db_path}.summary.json"), summary)
+    return summary
+
+
+def dry_run(campaign: Campaign, db_path, sets=None, only: str | None = None) -> str:
+    """Table of the selected cases: set, name, key and database status; counts per set."""
+    db = _open_db(Path(db_path))
+    selected = campaign.select(sets, only)
+    width = max([len(c.name) for c in selected] + [4])
+    lines = [f"{'set':<12} {'case':<{width}} {'key':<16} status", ""]
+    counts: dict = {}
+    for c in selected:
+        state = _state(db, c.key)
+        lines.insert(-1, f"{c.set:<12} {c.name:<{width}} {c.key} {state}")
+        counts.setdefault(c.set, {}).setdefault(state, 0)
+        counts[c.set][state] += 1
+    for name, cnt in counts.items():
+        detail = ", ".join(f"{v} {k}" for k, v in sorted(cnt.items()))
+        lines.append(f"{name}: {sum(cnt.values())} cases ({detail})")
+    lines.append(f"total: {len(selected)} cases")
+    return "\n".join(lines)
+
+
+# ============================================================================ command line
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog=f"python -m {ENTRY_POINT}",
+        description="Run the FE campaign into the reference database: cases already there are "
+                    "skipped, the rest run in parallel and are appended as they finish.")
+    p.add_argument("--campaign", default="data/campaign.toml", help="campaign file (TOML)")
+    p.add_argument("--db", default="data/reference.h5", help="reference database (HDF5)")
+    p.add_argument("--set", default="all", help="set to run: a set name of the campaign, or all")
+    p.add_argument("--only", metavar="SUBSTRING", help="only cases whose name contains SUBSTRING")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: number of cores; 0: in this process)")
+    p.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                   help="run on this Dask scheduler instead of local processes")
+    p.add_argument("--retry-failed", action="store_true", help="rerun cases recorded as failed")
+    p.add_argument("--retry-stopped", action="store_true",
+                   help="rerun cases stored as stopped (e.g. after raising max_wall_s) and replace them")
+    p.add_argument("--dry-run", action="store_true",
+                   help="list the cases, their keys and whether they are in the database; run nothing")
+    return p
+
+
+def _sets(campaign: Campaign, name: str):
+    if name == "all":
+        return None
+    if name not in campaign.sets:
+        raise ValueError(f"--set {name}: the campaign has the sets {', '.join(campaign.sets)} (or all)")
+    return {name}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Exit 0 when every selected case is in the database and none failed, 1 otherwise, 2 on bad input."""
+    args = build_parser().parse_args(argv)
+    try:
+        if args.workers is not None and args.workers < 0:
+            raise ValueError(f"--workers must be >= 0, got {args.workers}")
+        if args.workers is not None and args.scheduler:
+            raise ValueError("--workers applies to local runs; a Dask cluster brings its own workers")
+        campaign = load_campaign(args.campaign)
+        sets = _sets(campaign, args.set)
+        if args.dry_run:
+            print(dry_run(campaign, args.db, sets, args.only))
+            return 0
+        summary = run_campaign(campaign, args.db, sets=sets, only=args.only, workers=args.workers,
+                               scheduler=args.scheduler, retry_failed=args.retry_failed,
+                               retry_stopped=args.retry_stopped)
+    except ValueError as err:
+        print(f"{ENTRY_POINT}: error: {err}", file=sys.stderr)
+        return 2
+    print(format_summary(summary))
+    if Path(args.db).exists():
+        print(f"summary -> {args.db}.summary.json")
+    bad = summary["total"]["failed"] + summary["total"]["missing"]
+    return 0 if bad == 0 else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

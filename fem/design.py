@@ -1,0 +1,384 @@
+"""Campaign file: the FE design of experiments in dimensionless terms (TOML).
+
+A campaign has optional ``[campaign]`` metadata, ``[defaults]`` for every case,
+and one array of tables per set (``[[calibration]]``, ``[[validation]]``, any
+other name). Every entry names a ``scene`` and parameters; a list-valued
+parameter is a grid axis and an entry expands to the product of its lists::
+
+    [defaults]
+    h_max = 0.3
+    mesh_density = 1.0
+
+    [[calibration]]
+    scene = "flat"
+    E_over_sigma_y = [100, 1000]
+    nu = [0.2, 0.45]           # -> 4 cases
+
+Units: R1 = ``radius``, σY1 = ``sigma_y`` (both 1 by default); E, K and body 2's
+properties are ratios. Every parameter is checked against its range, sets must
+be disjoint, and each case gets a readable name (``flat-pp-E1000-nu0.3``).
+Parameters and ranges are in :data:`PARAMETERS`; ``data/README.md`` documents
+the format.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+from ..data import input_key
+from ..model.material import Material
+from .assembly import ELEMENTS
+from .mesh import DENSITY_RANGE
+from .solver import SolverOptions
+
+__all__ = ["PARAMETERS", "SCENES", "Param", "Case", "Campaign", "load_campaign", "parse_campaign"]
+
+SCENES = ("flat", "rigid_sphere", "two_body")
+_TWO = ("two_body",)
+
+
+@dataclass(frozen=True)
+class Param:
+    """One campaign parameter: allowed values, default, the scenes it applies to."""
+
+    doc: str
+    lo: float | None = None  # numeric bounds (None: unbounded)
+    hi: float | None = None
+    lo_open: bool = True
+    hi_open: bool = False
+    choices: tuple = ()  # allowed strings (string parameters)
+    default: object = None  # None: required, or taken from another parameter (see _resolve)
+    scenes: tuple = SCENES
+
+    def check(self, name: str, value, where: str):
+        """``value`` normalised (float or str); ValueError naming ``where``, the parameter and range."""
+        if self.choices:
+            if value not in self.choices:
+                raise ValueError(f"{where}: {name} = {value!r} is not one of {list(self.choices)}")
+            return value
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"{where}: {name} must be a number, got {value!r}")
+        x = float(value)
+        if math.isnan(x) or not self._inside(x):
+            raise ValueError(f"{where}: {name} = {value!r} out of range: must lie in {self.range_text()}")
+        return x
+
+    def _inside(self, x: float) -> bool:
+        lo = -math.inf if self.lo is None else self.lo
+        hi = math.inf if self.hi is None else self.hi
+        above = x > lo if self.lo_open else x >= lo
+        below = x < hi if self.hi_open else x <= hi
+        return above and below
+
+    def range_text(self) -> str:
+        if self.choices:
+            return " | ".join(self.choices)
+        lo = "-inf" if self.lo is None else f"{self.lo:g}"
+        hi = "inf" if self.hi is None else f"{self.hi:g}"
+        return f"{'(' if self.lo_open else '['}{lo}, {hi}{')' if self.hi_open else ']'}"
+
+
+#: every parameter a campaign entry or [defaults] may set
+PARAMETERS = {
+    "scene": Param("flat: hemisphere on a rigid flat (= two equal spheres); rigid_sphere: on a rigid "
+                   "sphere of indenter_radius; two_body: two deformable spheres", choices=SCENES),
+    "E_over_sigma_y": Param("Young's modulus of body 1 over its yield stress, E1/σY1", lo=1, hi=1e7),
+    "nu": Param("Poisson's ratio of body 1", lo=-1, hi=0.5, hi_open=True, default=0.3),
+    "K_over_sigma_y": Param("Ludwik hardening modulus of body 1 over σY1 (0: perfectly plastic)",
+                            lo=0, hi=1e4, lo_open=False, default=0.0),
+    "n": Param("Ludwik hardening exponent of body 1 (ignored, stored as 1, when K = 0)", lo=0, hi=1,
+               default=1.0),
+    "h_max": Param("final approach in units of R1 (two_body: of min(R1, R2))", lo=0, hi=0.8),
+    "mesh_density": Param("mesh-density factor of the FE mesh", lo=DENSITY_RANGE[0], hi=DENSITY_RANGE[1],
+                          lo_open=False, default=1.0),
+    "element": Param("finite element", choices=tuple(sorted(ELEMENTS)), default="q8r"),
+    "max_wall_s": Param("wall-time limit of one run in seconds (the run is stored as stopped)",
+                        lo=0, default=math.inf),
+    "radius": Param("radius R1 of body 1 (the length unit)", lo=0, hi=1e12, hi_open=True, default=1.0),
+    "sigma_y": Param("yield stress σY1 of body 1 (the stress unit)", lo=0, hi=1e15, hi_open=True,
+                     default=1.0),
+    "indenter_radius": Param("radius of the rigid sphere in units of R1", lo=0, hi=1e6,
+                             scenes=("rigid_sphere",)),
+    "radius2": Param("radius of body 2 in units of R1", lo=0, hi=1e3, default=1.0, scenes=_TWO),
+    "E2_over_E1": Param("Young's modulus of body 2 over that of body 1", lo=0, hi=1e4, default=1.0,
+                        scenes=_TWO),
+    "nu2": Param("Poisson's ratio of body 2 (default: nu)", lo=-1, hi=0.5, hi_open=True, scenes=_TWO),
+    "sigma_y2_over_sigma_y1": Param("yield stress of body 2 over σY1", lo=0, hi=1e4, default=1.0,
+                                    scenes=_TWO),
+    "K2_over_sigma_y1": Param("Ludwik modulus of body 2 over σY1 (default: K_over_sigma_y)", lo=0,
+                              hi=1e4, lo_open=False, scenes=_TWO),
+    "n2": Param("Ludwik exponent of body 2 (default: n)", lo=0, hi=1, scenes=_TWO),
+}
+#: body-2 parameters whose default is body 1's value
+_FROM_BODY1 = {"nu2": "nu", "K2_over_sigma_y1": "K_over_sigma_y", "n2": "n"}
+#: solver options a campaign may set in an ``options`` table (max_wall_s has its own key)
+OPTION_NAMES = tuple(f.name for f in fields(SolverOptions) if f.name != "max_wall_s")
+#: keys of an entry besides PARAMETERS
+_ENTRY_KEYS = ("options",)
+_SETS_RESERVED = ("campaign", "defaults")
+
+
+# ============================================================================ cases
+@dataclass(frozen=True)
+class Case:
+    """One expanded campaign case: names, parameters, and the inputs of its FE run.
+
+    ``inputs`` (dimensional, consistent units) are what the database key hashes:
+    material, radius, h_max, mesh_density, element, options (those set by the
+    campaign) and indenter_radius, or radius2 and material2 for two bodies.
+    ``max_wall_s`` is a resource limit, not an input.
+    """
+
+    set: str
+    name: str
+    entry: str
+    params: dict
+    inputs: dict
+    max_wall_s: float
+    key: str = field(init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "key", input_key(self.inputs))
+
+    @property
+    def scene(self) -> str:
+        return self.params["scene"]
+
+    def run_kwargs(self) -> dict:
+        """Keyword arguments of ``fem.io.run_indentation`` for this case."""
+        i = self.inputs
+        kw = {"material": _material(i["material"]), "radius": i["radius"], "h_max": i["h_max"],
+              "density": i["mesh_density"], "element": i["element"],
+              "options": SolverOptions(**i["options"], max_wall_s=self.max_wall_s)}
+        if self.scene == "two_body":
+            kw.update(radius2=i["radius2"], material2=_material(i["material2"]))
+        else:
+            kw["indenter_radius"] = i["indenter_radius"]
+        return kw
+
+
+def _material(d: dict) -> Material:
+    return Material(E=d["E"], nu=d["nu"], sigma_y=d["sigma_y"], K=d["K"], n=d["n"])
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """A parsed campaign: its text, source, metadata, set names and expanded cases."""
+
+    text: str
+    source: str
+    meta: dict
+    sets: tuple
+    cases: tuple
+
+    def select(self, sets=None, only: str | None = None) -> list[Case]:
+        """Cases of the given sets (None: all) whose name contains ``only``."""
+        return [c for c in self.cases
+                if (sets is None or c.set in sets) and (not only or only in c.name)]
+
+
+# ============================================================================ parsing
+def _fmt(x: float) -> str:
+    return f"{x:.10g}"
+
+
+def _hardening(K: float, n: float) -> str:
+    return "pp" if K == 0 else f"K{_fmt(K)}-n{_fmt(n)}"
+
+
+def _name(p: dict, defaults: dict) -> str:
+    """Readable case name from the resolved parameters."""
+    scene = {"flat": "flat", "rigid_sphere": f"rsphere{_fmt(p.get('indenter_radius', 0))}",
+             "two_body": "two"}[p["scene"]]
+    parts = [scene, _hardening(p["K_over_sigma_y"], p["n"]), f"E{_fmt(p['E_over_sigma_y'])}",
+             f"nu{_fmt(p['nu'])}"]
+    if p["scene"] == "two_body":
+        other = []
+        if p["radius2"] != 1:
+            other.append(f"R{_fmt(p['radius2'])}")
+        if p["E2_over_E1"] != 1:
+            other.append(f"E{_fmt(p['E2_over_E1'] * p['E_over_sigma_y'])}")
+        if p["nu2"] != p["nu"]:
+            other.append(f"nu{_fmt(p['nu2'])}")
+        if p["sigma_y2_over_sigma_y1"] != 1:
+            other.append(f"sy{_fmt(p['sigma_y2_over_sigma_y1'])}")
+        if (p["K2_over_sigma_y1"], p["n2"]) != (p["K_over_sigma_y"], p["n"]):
+            other.append(_hardening(p["K2_over_sigma_y1"], p["n2"]))
+        parts += ["vs", *(other or ["same"])]
+    for key, tag in (("h_max", "h"), ("mesh_density", "d")):
+        if p[key] != defaults.get(key, PARAMETERS[key].default):
+            parts.append(f"{tag}{_fmt(p[key])}")
+    if p["element"] != defaults.get("element", PARAMETERS["element"].default):
+        parts.append(p["element"])
+    return "-".join(parts)
+
+
+def _check_options(options, where: str) -> dict:
+    """A table of solver options: known names, valid values (SolverOptions.validate)."""
+    if not isinstance(options, dict):
+        raise ValueError(f"{where}: options must be a table of solver options, got {options!r}")
+    unknown = sorted(set(options) - set(OPTION_NAMES))
+    if unknown:
+        hint = " (max_wall_s is a parameter of its own)" if "max_wall_s" in unknown else ""
+        raise ValueError(f"{where}: unknown solver option {unknown[0]!r}{hint}; "
+                         f"known: {', '.join(OPTION_NAMES)}")
+    try:
+        SolverOptions(**options).validate()
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{where}: options: {err}") from None
+    return dict(options)
+
+
+def _check_keys(table: dict, where: str) -> None:
+    unknown = [k for k in table if k not in PARAMETERS and k not in _ENTRY_KEYS]
+    if unknown:
+        raise ValueError(f"{where}: unknown parameter {unknown[0]!r}; known: "
+                         f"{', '.join([*PARAMETERS, *_ENTRY_KEYS])}")
+
+
+def _resolve(raw: dict, defaults: dict, where: str) -> tuple[dict, dict]:
+    """One grid point (entry over defaults) → (checked parameters, options)."""
+    scene = PARAMETERS["scene"].check("scene", raw.get("scene", defaults.get("scene")), where)
+    for name in raw:
+        if name in PARAMETERS and scene not in PARAMETERS[name].scenes:
+            raise ValueError(f"{where}: parameter {name} applies to scene "
+                             f"{' | '.join(PARAMETERS[name].scenes)} only, not {scene!r}")
+    p = {"scene": scene}
+    for name, spec in PARAMETERS.items():
+        if name == "scene" or scene not in spec.scenes:
+            continue
+        value = raw.get(name, defaults.get(name, spec.default))
+        if value is None and name in _FROM_BODY1:
+            value = p[_FROM_BODY1[name]]
+        if value is None:
+            raise ValueError(f"{where}: parameter {name} is required ({spec.doc}; range "
+                             f"{spec.range_text()})")
+        p[name] = spec.check(name, value, where)
+    if p["K_over_sigma_y"] == 0:
+        p["n"] = 1.0  # perfectly plastic: n has no effect
+    if scene == "two_body" and p["K2_over_sigma_y1"] == 0:
+        p["n2"] = 1.0
+    if scene == "two_body" and p["K_over_sigma_y"] == 0 and "n2" not in raw and "n2" not in defaults \
+            and p["K2_over_sigma_y1"] != 0:
+        raise ValueError(f"{where}: body 2 hardens (K2_over_sigma_y1 = {p['K2_over_sigma_y1']:g}) "
+                         "but body 1 is perfectly plastic: give n2")
+    options = {**defaults.get("options", {}), **raw.get("options", {})}
+    return p, _check_options(options, where)
+
+
+def _inputs(p: dict, options: dict) -> dict:
+    """Dimensional inputs of the FE run (what the key hashes)."""
+    R, sy = p["radius"], p["sigma_y"]
+    E = p["E_over_sigma_y"] * sy
+    mat = Material(E=E, nu=p["nu"], sigma_y=sy, K=p["K_over_sigma_y"] * sy, n=p["n"]).describe()
+    inputs = {"material": mat, "radius": R, "mesh_density": p["mesh_density"],
+              "element": p["element"], "options": dict(options)}
+    if p["scene"] == "two_body":
+        R2 = p["radius2"] * R
+        inputs.update(h_max=p["h_max"] * min(R, R2), radius2=R2, material2=Material(
+            E=p["E2_over_E1"] * E, nu=p["nu2"], sigma_y=p["sigma_y2_over_sigma_y1"] * sy,
+            K=p["K2_over_sigma_y1"] * sy, n=p["n2"]).describe())
+    else:
+        inputs.update(h_max=p["h_max"] * R,
+                      indenter_radius=p["indenter_radius"] * R if p["scene"] == "rigid_sphere"
+                      else math.inf)
+    return inputs
+
+
+def _expand(entry: dict, where: str) -> list[dict]:
+    """Grid expansion: list-valued parameters → their product (entry order, last fastest)."""
+    axes = []
+    for name, value in entry.items():
+        if isinstance(value, list):
+            if not value:
+                raise ValueError(f"{where}: parameter {name} is an empty list")
+            if any(isinstance(v, list | dict) for v in value):
+                raise ValueError(f"{where}: parameter {name}: grid values must be single values")
+            axes.append([(name, v) for v in value])
+        else:
+            axes.append([(name, value)])
+    return [dict(point) for point in itertools.product(*axes)]
+
+
+def _cases_of_set(set_name: str, entries, defaults: dict) -> list[Case]:
+    if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
+        raise ValueError(f"set {set_name!r} must be an array of tables ([[{set_name}]])")
+    cases = []
+    for i, entry in enumerate(entries, start=1):
+        where = f"[[{set_name}]] entry {i}"
+        _check_keys(entry, where)
+        if "options" in entry and not isinstance(entry["options"], dict):
+            raise ValueError(f"{where}: options must be a table of solver options")
+        for point in _expand(entry, where):
+            p, options = _resolve(point, defaults, where)
+            wall = p.pop("max_wall_s")
+            cases.append(Case(set=set_name, name=_name(p, defaults), entry=where, params=p,
+                              inputs=_inputs(p, options), max_wall_s=wall))
+    return cases
+
+
+def _check_unique(cases: list[Case]) -> None:
+    """No case twice (same key or same name), in one set or across sets."""
+    by_key: dict = {}
+    by_name: dict = {}
+    for c in cases:
+        prev = by_key.setdefault(c.key, c)
+        if prev is not c:
+            what = "appears in both sets" if prev.set != c.set else "appears twice"
+            raise ValueError(f"case {c.name} {what}: {prev.entry} and {c.entry} have the same "
+                             "inputs (sets must be disjoint, cases unique)")
+        prev = by_name.setdefault(c.name, c)
+        if prev is not c:
+            raise ValueError(f"{prev.entry} and {c.entry} both give a case named {c.name} with "
+                             "different inputs (solver options?); make them differ in a named "
+                             "parameter")
+
+
+def parse_campaign(text: str, source: str = "<campaign>") -> Campaign:
+    """Parse and validate campaign TOML text; ValueError naming the entry and parameter."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ValueError(f"{source}: not valid TOML: {err}") from None
+    try:
+        meta = doc.get("campaign", {})
+        if not isinstance(meta, dict):
+            raise ValueError("[campaign] must be a table (title, description)")
+        defaults = doc.get("defaults", {})
+        if not isinstance(defaults, dict):
+            raise ValueError("[defaults] must be a table")
+        _check_keys(defaults, "[defaults]")
+        for name, value in defaults.items():
+            if isinstance(value, list):
+                raise ValueError(f"[defaults]: {name} must be a single value (grids go in entries)")
+            if name != "options":
+                PARAMETERS[name].check(name, value, "[defaults]")
+        if "options" in defaults:
+            _check_options(defaults["options"], "[defaults]")
+        sets = [k for k in doc if k not in _SETS_RESERVED]
+        if not sets:
+            raise ValueError("no sets: add entries such as [[calibration]] and [[validation]]")
+        cases = []
+        for name in sets:
+            if not name.replace("_", "").replace("-", "").isalnum():
+                raise ValueError(f"set name {name!r} must be letters, digits, '_' or '-'")
+            cases += _cases_of_set(name, doc[name], defaults)
+        _check_unique(cases)
+    except ValueError as err:
+        raise ValueError(f"{source}: {err}") from None
+    return Campaign(text=text, source=source, meta=dict(meta), sets=tuple(sets),
+                    cases=tuple(sorted(cases, key=lambda c: (c.set, c.name))))
+
+
+def load_campaign(path) -> Campaign:
+    """Read and validate the campaign file ``path``."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise ValueError(f"{path}: cannot read the campaign file: {err.strerror or err}") from None
+    return parse_campaign(text, source=str(path))
