@@ -8,6 +8,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
 .PHONY: test bench lint verify-fem demo clean
+.PHONY: fem
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -21,6 +22,9 @@ test: $(STAMP)
 
 demo: $(STAMP)
 	$(PY) -m spherecontact.demo --out reports/demo
+
+fem: $(STAMP)
+	$(PY) -m spherecontact.fem.campaign --campaign data/campaign.toml --db data/reference.h5
 
 verify-fem: $(STAMP)
 	$(PY) -m spherecontact.fem.verification --out reports/fem
