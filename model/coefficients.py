@@ -1,10 +1,10 @@
 """Coefficient set of the level functions H̄(Λ), c²(Λ) (DESIGN §2), stored as versioned JSON.
 
 The set is read from ``data/coefficients.json`` (the ``SPHERECONTACT_COEFFICIENTS``
-environment variable names another file). If the shipped file is missing, the
-built-in literature set :data:`LITERATURE` (identical to the shipped file) is used.
-The JSON schema is documented in ``model/README.md``; calibration writes new
-values into the same schema with ``"source": "calibration"``.
+environment variable names another file); calibration writes it with
+``"source": "calibration"``. If the shipped file is missing, the built-in literature
+set :data:`LITERATURE` (schema 1) is used. The JSON schema is documented in
+``model/README.md``.
 
 Functional forms fixed by the schema (symbols of DESIGN §1–2):
 
@@ -13,7 +13,16 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
 * Level II, t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) ∈ [0, 1]:
   q(t) = q_I + (q_III − q_I) · [t + t(1 − t) Σ_k shape[k] t^k]  (continuous at both ends);
 * finite size, geometric ratio x (a/ρ_i or a/R_i):  q → q · (1 + Σ_k coeffs[k] x^(k+1)),
-  which vanishes as x → 0.
+  which vanishes as x → 0;
+* large-deformation collapse (schema 2, optional; same ratio x): the half-space values
+  H̄_hs, c²_hs above are blended with limits of the whole body,
+  L(x, n) = prefactor · x^(−exponent) · exp(Σ_k x_poly[k] x^(k+1) + Σ_k exp_poly[k] n^(k+1)),
+  r = H̄_hs/H̄_c,  w = r^k/(1 + r^k)  (k = sharpness),
+  H̄ = H̄_hs (1 + r^k)^(−1/k)   (smooth minimum of H̄_hs and H̄_c),
+  c² = c²_hs^(1−w) · c²_c^w;  H̄_c → ∞ as x → 0 (exponent > 0), so w → 0 and the
+  correction vanishes.
+
+Schema 1 files (the literature set) are still read; they have no collapse block.
 """
 
 from __future__ import annotations
@@ -30,6 +39,8 @@ import numpy as np
 
 __all__ = [
     "SCHEMA_VERSION",
+    "SUPPORTED_VERSIONS",
+    "CollapseLimit",
     "LITERATURE",
     "Coefficients",
     "default_path",
@@ -37,13 +48,16 @@ __all__ = [
     "default_coefficients",
 ]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: schema versions this reader accepts (1: no ``collapse`` block)
+SUPPORTED_VERSIONS = (1, 2)
 ENV_VAR = "SPHERECONTACT_COEFFICIENTS"
 SOURCES = ("literature", "calibration")
 RATIOS = ("a_over_rho", "a_over_R")
 EXPONENT_METHODS = ("secant_loglog",)
 
-#: Built-in literature set; identical to the shipped ``data/coefficients.json``.
+#: Built-in literature set (schema 1): the starting values of calibration and the fallback
+#: when ``data/coefficients.json`` is missing.
 LITERATURE: dict = {
     "schema_version": 1,
     "source": "literature",
@@ -156,6 +170,18 @@ def _choice(d: dict, key: str, where: str, allowed: tuple[str, ...]) -> str:
     return v
 
 
+def _limit(d, where: str) -> CollapseLimit:
+    """A collapse limit {prefactor, exponent, x_poly, exp_poly} (see module docstring)."""
+    if not isinstance(d, dict):
+        raise ValueError(f"coefficients: '{where}' must be an object, got {type(d).__name__}")
+    pre = _number(d, "prefactor", where + ".")
+    if pre <= 0.0:
+        raise ValueError(f"coefficients: '{where}.prefactor' must be > 0, got {pre!r}")
+    return CollapseLimit(prefactor=pre, exponent=_number(d, "exponent", where + "."),
+                         x_poly=_poly(d, "x_poly", where + "."),
+                         exp_poly=_poly(d, "exp_poly", where + "."))
+
+
 def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
     """prefactor · exp(Σ_k c_k n^(k+1)), vectorised in n."""
     n = np.asarray(n, dtype=float)
@@ -163,6 +189,42 @@ def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
     for c in reversed(exp_poly):
         s = (s + c) * n
     return prefactor * np.exp(s)
+
+
+def _poly_and_slope(x, poly: tuple[float, ...]):
+    """Σ_k c_k x^(k+1) and its log slope x d/dx = Σ_k (k+1) c_k x^(k+1)."""
+    s = np.zeros_like(x)
+    ds = np.zeros_like(x)
+    for k in range(len(poly) - 1, -1, -1):
+        s = (s + poly[k]) * x
+        ds = (ds + (k + 1) * poly[k]) * x
+    return s, ds
+
+
+@dataclass(frozen=True)
+class CollapseLimit:
+    """L(x, n) = prefactor · x^(−exponent) · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1))."""
+
+    prefactor: float
+    exponent: float
+    x_poly: tuple[float, ...] = ()
+    exp_poly: tuple[float, ...] = ()
+
+    def log_and_slope(self, x, n=0.0):
+        """ln L(x, n) and d ln L/d ln x, vectorised (x > 0)."""
+        x = np.asarray(x, dtype=float)
+        s, ds = _poly_and_slope(x, self.x_poly)
+        with np.errstate(divide="ignore"):
+            lnL = (math.log(self.prefactor) - self.exponent * np.log(x) + s
+                   + np.log(_exp_poly(1.0, self.exp_poly, n)))
+        return lnL, ds - self.exponent
+
+    def __call__(self, x, n=0.0):
+        return np.exp(self.log_and_slope(x, n)[0])
+
+    def to_dict(self) -> dict:
+        return {"prefactor": self.prefactor, "exponent": self.exponent,
+                "x_poly": list(self.x_poly), "exp_poly": list(self.exp_poly)}
 
 
 @dataclass(frozen=True)
@@ -184,6 +246,9 @@ class Coefficients:
     finite_size_ratio: str
     finite_size_H_bar: tuple[float, ...]
     finite_size_c2: tuple[float, ...]
+    collapse_H_bar: CollapseLimit | None = None
+    collapse_c2: CollapseLimit | None = None
+    collapse_sharpness: float = 0.0
     source: str = "literature"
     schema_version: int = SCHEMA_VERSION
     provenance: dict = field(default_factory=dict, compare=False, hash=False, repr=False)
@@ -192,16 +257,18 @@ class Coefficients:
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_dict(cls, d: dict) -> Coefficients:
-        """Validate a schema-v1 dictionary; ValueError names the offending key."""
+        """Validate a schema-1 or schema-2 dictionary; ValueError names the offending key."""
         if not isinstance(d, dict):
             raise ValueError(f"coefficients: top level must be an object, got {type(d).__name__}")
         if "schema_version" not in d:
             raise ValueError("coefficients: missing key 'schema_version'")
-        if d["schema_version"] != SCHEMA_VERSION or isinstance(d["schema_version"], bool):
+        version = d["schema_version"]
+        if isinstance(version, bool) or version not in SUPPORTED_VERSIONS:
             raise ValueError(
-                f"coefficients: unknown 'schema_version' {d['schema_version']!r} "
-                f"(this version reads schema_version = {SCHEMA_VERSION})"
+                f"coefficients: unknown 'schema_version' {version!r} "
+                f"(this version reads schema_version in {SUPPORTED_VERSIONS})"
             )
+        version = int(version)
         source = _choice(d, "source", "", SOURCES)
         provenance = _section(d, "provenance")
         beta = _number(d, "beta", "")
@@ -235,6 +302,30 @@ class Coefficients:
         refs = d.get("references", {})
         if not isinstance(refs, dict):
             raise ValueError("coefficients: 'references' must be an object")
+        cH = cc = None
+        k = 0.0
+        if version >= 2:
+            if "collapse" not in d:
+                raise ValueError("coefficients: missing key 'collapse' (required by schema_version 2; "
+                                 "null for none)")
+            col = d["collapse"]
+            if col is not None:
+                if not isinstance(col, dict):
+                    raise ValueError(f"coefficients: 'collapse' must be an object or null, "
+                                     f"got {type(col).__name__}")
+                cH = _limit(_section(col, "H_bar"), "collapse.H_bar")
+                cc = _limit(_section(col, "c2"), "collapse.c2")
+                k = _number(col, "sharpness", "collapse.")
+                if k <= 0.0:
+                    raise ValueError(f"coefficients: 'collapse.sharpness' must be > 0, got {k!r}")
+                if cH.exponent <= 0.0:
+                    raise ValueError("coefficients: 'collapse.H_bar.exponent' must be > 0 (the limit "
+                                     f"must vanish as the ratio -> 0), got {cH.exponent!r}")
+                if cc.exponent < 0.0:
+                    raise ValueError(f"coefficients: 'collapse.c2.exponent' must be >= 0, "
+                                     f"got {cc.exponent!r}")
+        elif "collapse" in d:
+            raise ValueError("coefficients: key 'collapse' needs schema_version 2")
         return cls(
             beta=beta,
             Lambda_I=lam1,
@@ -251,15 +342,18 @@ class Coefficients:
             finite_size_ratio=_choice(fs, "ratio", "finite_size.", RATIOS),
             finite_size_H_bar=_poly(fs, "H_bar", "finite_size."),
             finite_size_c2=_poly(fs, "c2", "finite_size."),
+            collapse_H_bar=cH,
+            collapse_c2=cc,
+            collapse_sharpness=k,
             source=source,
-            schema_version=SCHEMA_VERSION,
+            schema_version=version,
             provenance=copy.deepcopy(provenance),
             references=copy.deepcopy(refs),
         )
 
     def to_dict(self) -> dict:
-        """The schema-v1 dictionary (round-trips through :meth:`from_dict`)."""
-        return {
+        """The dictionary of this set's schema version (round-trips through :meth:`from_dict`)."""
+        d = {
             "schema_version": self.schema_version,
             "source": self.source,
             "provenance": copy.deepcopy(self.provenance),
@@ -274,8 +368,13 @@ class Coefficients:
                                    "eps_hi": self.eps_hi},
             "finite_size": {"ratio": self.finite_size_ratio, "H_bar": list(self.finite_size_H_bar),
                             "c2": list(self.finite_size_c2)},
-            "references": copy.deepcopy(self.references),
         }
+        if self.schema_version >= 2:
+            d["collapse"] = None if not self.has_collapse else {
+                "H_bar": self.collapse_H_bar.to_dict(), "c2": self.collapse_c2.to_dict(),
+                "sharpness": self.collapse_sharpness}
+        d["references"] = copy.deepcopy(self.references)
+        return d
 
     def replace(self, **changes) -> Coefficients:
         """A validated copy with some schema keys changed (``replace(beta=0.2)``).
@@ -306,7 +405,11 @@ class Coefficients:
 
     @property
     def has_finite_size(self) -> bool:
-        return any(self.finite_size_H_bar) or any(self.finite_size_c2)
+        return any(self.finite_size_H_bar) or any(self.finite_size_c2) or self.has_collapse
+
+    @property
+    def has_collapse(self) -> bool:
+        return self.collapse_H_bar is not None
 
 
 def default_path() -> Path:

@@ -10,11 +10,16 @@ s(t) = t + t(1 − t)·Σ_k b_k t^k (b_k: ``level_II`` shape terms; none → str
 in ln Λ, seed §2), so H̄ and c² are continuous at Λ_I and Λ_III. All functions are pure
 and vectorised; ``n`` is the effective hardening exponent (broadcast with Λ).
 The finite-size factor 1 + Σ_k f_k x^(k+1) multiplies H̄ and c² (x = a/ρ or a/R).
+The large-deformation collapse (:func:`collapse_blend`) then blends these half-space
+values with the whole-body limits H̄_c(x, n), c²_c(x, n):
+
+    r = H̄_hs/H̄_c,  w = r^k/(1 + r^k),  H̄ = H̄_hs (1 + r^k)^(−1/k),  c² = c²_hs^(1−w) c²_c^w.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -28,6 +33,8 @@ __all__ = [
     "H_bar_and_slope",
     "c2_and_slope",
     "finite_size_factor",
+    "collapse_blend",
+    "CollapseBlend",
     "levels_scalar_n",
 ]
 
@@ -132,13 +139,70 @@ def finite_size_factor(x, poly: tuple[float, ...]):
     return f, ds / f
 
 
+class CollapseBlend(NamedTuple):
+    """Result of :func:`collapse_blend` (arrays)."""
+
+    H_bar: np.ndarray        # blended H̄
+    c2: np.ndarray           # blended c²
+    w: np.ndarray            # collapse weight w ∈ [0, 1)
+    dlnHc_dlnx: np.ndarray   # d ln H̄_c/d ln x
+    lnc2_gap: np.ndarray     # ln c²_c − ln c²_hs
+    dlnc2c_dlnx: np.ndarray  # d ln c²_c/d ln x
+
+
+def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0) -> CollapseBlend:
+    """Blend the half-space values with the whole-body collapse limits (module docstring).
+
+    Parameters
+    ----------
+    H_hs, c2_hs : half-space H̄ and c² (finite-size factor included); H_hs = 0 for an
+        elastic body (never collapses).
+    x : finite-size ratio (a/R or a/ρ), > 0.
+    coeffs : coefficient set; without a collapse block the inputs are returned (w = 0).
+    n : effective hardening exponent.
+
+    Log derivatives of the result follow from those of the inputs:
+    d ln H̄ = (1 − w) d ln H̄_hs + w d ln H̄_c and
+    d ln c² = (1 − w) d ln c²_hs + w d ln c²_c + (ln c²_c − ln c²_hs) dw,
+    dw = k w (1 − w) (d ln H̄_hs − d ln H̄_c).
+    """
+    H_hs, c2_hs, x, n = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (H_hs, c2_hs, x, n)))
+    zero = np.zeros_like(H_hs)
+    if not coeffs.has_collapse:
+        return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero)
+    k = coeffs.collapse_sharpness
+    lnHc, sHc = coeffs.collapse_H_bar.log_and_slope(x, n)
+    lncc, scc = coeffs.collapse_c2.log_and_slope(x, n)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
+        # w = r^k/(1 + r^k) and ln(1 + r^k), without overflow
+        z = k * lnr
+        w = np.where(z > 0.0, 1.0 / (1.0 + np.exp(-z)), np.exp(z) / (1.0 + np.exp(z)))
+        log1p = np.where(z > 0.0, z + np.log1p(np.exp(-z)), np.log1p(np.exp(z)))
+        H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
+        gap = np.where(w > 0.0, lncc - np.log(c2_hs), 0.0)
+        c = c2_hs * np.exp(w * gap)
+    return CollapseBlend(H, c, w, sHc, gap, scc)
+
+
 def H_bar(Lambda, coeffs: Coefficients, n=0.0, x=0.0):
-    """Normalised hardness H̄ = p_m/σ_rep (seed eq. 1) with the finite-size factor at x."""
+    """Normalised hardness H̄ = p_m/σ_rep (seed eq. 1) with the finite-size factor and the
+    collapse blend at x."""
     H, _ = H_bar_and_slope(Lambda, coeffs, n)
-    return H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
+    H = H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
+    if not coeffs.has_collapse:
+        return H
+    c, _ = c2_and_slope(Lambda, coeffs, n)
+    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n).H_bar
 
 
 def c2(Lambda, coeffs: Coefficients, n=0.0, x=0.0):
-    """Contact-area parameter c² = a²/(2hρ) (seed eq. 5) with the finite-size factor at x."""
+    """Contact-area parameter c² = a²/(2hρ) (seed eq. 5) with the finite-size factor and the
+    collapse blend at x."""
     c, _ = c2_and_slope(Lambda, coeffs, n)
-    return c * finite_size_factor(x, coeffs.finite_size_c2)[0]
+    c = c * finite_size_factor(x, coeffs.finite_size_c2)[0]
+    if not coeffs.has_collapse:
+        return c
+    H, _ = H_bar_and_slope(Lambda, coeffs, n)
+    H = H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
+    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n).c2

@@ -10,6 +10,14 @@ finite-size ratio when it is a/R):
 Log slopes used by the two-body solver and for dF/dh (m = d ln σ_f/d ln ε at ε_rep):
 
     ∂ln p_m/∂ln x = (d ln H̄/d ln Λ)(1 − m) + m,   ∂ln c²/∂ln x = (d ln c²/d ln Λ)(1 − m).
+
+With a collapse block (``levels.collapse_blend``; y = finite-size ratio, n = effective
+exponent), the half-space p_hs = H̄_hs σ_rep and c²_hs are blended with the whole-body
+limits: ln r = ln p_hs − ln σ_rep − ln H̄_c(y), w = r^k/(1 + r^k),
+p_m = p_hs (1 + r^k)^(−1/k), c² = c²_hs^(1−w) c²_c(y)^w, and
+
+    ∂ln p_m = (1 − w) ∂ln p_hs + w (∂ln σ_rep + ∂ln H̄_c),
+    ∂ln c²  = (1 − w) ∂ln c²_hs + w ∂ln c²_c + (ln c²_c − ln c²_hs) k w (1 − w) ∂ln r.
 """
 
 from __future__ import annotations
@@ -21,7 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
-from .levels import finite_size_factor, levels_scalar_n
+from .levels import collapse_blend, finite_size_factor, levels_scalar_n
 from .material import Material
 
 __all__ = [
@@ -130,10 +138,22 @@ class BodyLaw:
         fH, dfH = finite_size_factor(y, co.finite_size_H_bar)
         fc, dfc = finite_size_factor(y, co.finite_size_c2)
         piece = lev + 3 * _segment(mat, eps)
+        p, c = p * fH, c * fc
+        dp_x, dp_y = sH * (1.0 - m) + m, dfH
+        dc_x, dc_y = sc * (1.0 - m), dfc
+        if co.has_collapse and not math.isinf(mat.sigma_y):
+            b = collapse_blend(p / sig, c, y, co, self.n_eff)
+            w, v = b.w, co.collapse_sharpness * b.w * (1.0 - b.w) * b.lnc2_gap
+            dr_x, dr_y = dp_x - m, dp_y - b.dlnHc_dlnx  # ∂ln r
+            p = b.H_bar * sig
+            dp_x, dp_y = (1.0 - w) * dp_x + w * m, (1.0 - w) * dp_y + w * b.dlnHc_dlnx
+            dc_x = (1.0 - w) * dc_x + v * dr_x
+            dc_y = (1.0 - w) * dc_y + w * b.dlnc2c_dlnx + v * dr_y
+            c = b.c2
         return BodyResponse(
-            p_m=p * fH, c2=c * fc, Lambda=Lam, sigma_rep=sig,
-            dlnp_dlnx=sH * (1.0 - m) + m, dlnp_dlny=dfH,
-            dlnc2_dlnx=sc * (1.0 - m), dlnc2_dlny=dfc, piece=piece,
+            p_m=p, c2=c, Lambda=Lam, sigma_rep=sig,
+            dlnp_dlnx=dp_x, dlnp_dlny=dp_y,
+            dlnc2_dlnx=dc_x, dlnc2_dlny=dc_y, piece=piece,
         )
 
 

@@ -1,0 +1,251 @@
+"""Calibration points from FE runs: ρ, σ_rep, Λ, H̄, c², a/R per increment (DESIGN §2).
+
+A run is one deformable hemisphere (radius R) pressed by a rigid surface of radius
+R_i (``inf``: the flat that stands for an equal sphere by symmetry). The body sees the
+relative radius
+
+    ρ = R R_i/(R + R_i)        (ρ = R for the flat),
+
+and, with h the approach taken by this body, the Brinell-type quantities are
+
+    ε_rep = β a/ρ,  σ_rep = σ_f(ε_rep),  Λ = E' a/(σ_rep ρ),
+    H̄ = p_m/σ_rep = F/(π a² σ_rep),   c² = a²/(2 h ρ).
+
+Only σ_rep (hence Λ and H̄) depends on the coefficient β; :func:`quantities` evaluates
+them for any β, :class:`Dataset` holds what does not depend on it.
+
+Curves, not increments, carry the information: the FE force has a small staircase at
+large a/R (one step per surface node closing) and the increments are spaced unevenly.
+Each run is therefore resampled on a fixed grid in ln h (``per_decade`` nodes per
+decade, the same nodes for every run) by a local linear fit of ln F and ln a against
+ln h over the increments within one grid step of the node (triangular weights).
+This is exact for power laws (Hertz: F ∝ h^{3/2}, a ∝ h^{1/2}) and averages the
+staircase over about two nodes of the surface mesh.
+
+Resolution filter: the pole zone of the FE mesh has elements of 0.003 R/density.
+The sub-element contact radius is within 0.5 % of Hertz (both p_m and c², elastic
+run of the FE verification) from a ≈ 0.02 R on, i.e. about seven pole elements, and
+off by 1–5 % below; points with a < ``A_MIN_ELEMENTS`` pole elements are dropped.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.material import Material
+
+__all__ = [
+    "A_MIN_ELEMENTS",
+    "POLE_ELEMENT",
+    "PER_DECADE",
+    "RunCurve",
+    "Dataset",
+    "relative_radius",
+    "resample",
+    "run_curve",
+    "build_dataset",
+    "quantities",
+    "material_label",
+]
+
+#: size of the pole-zone elements of the FE mesh at density 1, in units of R
+POLE_ELEMENT = 0.003
+#: smallest usable contact radius, in pole elements (a ≥ 0.02 R at density 1)
+A_MIN_ELEMENTS = 20.0 / 3.0
+#: grid nodes per decade of h
+PER_DECADE = 16
+
+
+def relative_radius(radius: float, indenter_radius: float) -> float:
+    """ρ = R R_i/(R + R_i); ρ = R for a rigid flat (R_i = inf)."""
+    if math.isinf(indenter_radius):
+        return float(radius)
+    return float(radius * indenter_radius / (radius + indenter_radius))
+
+
+def material_label(m: Material) -> str:
+    """Short label of a material: E/σY, ν and the Ludwik hardening (K/σY, n)."""
+    if math.isinf(m.sigma_y):
+        return f"elastic nu={m.nu:g}"
+    s = f"E/sy={m.E / m.sigma_y:g} nu={m.nu:g}"
+    if m.is_tabulated:
+        return s + " table"
+    if m.K > 0.0:
+        s += f" K/sy={m.K / m.sigma_y:g} n={m.n:g}"
+    return s
+
+
+def resample(h, F, a, lnh_grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """F and a at the grid approaches by local linear fits in ln–ln (module docstring).
+
+    Parameters
+    ----------
+    h, F, a : FE curves (increasing h, positive values).
+    lnh_grid : ln h of the grid nodes (uniform step Δ).
+
+    Returns
+    -------
+    F_grid, a_grid : arrays like ``lnh_grid``.
+    """
+    x = np.log(np.asarray(h, dtype=float))
+    Y = np.log(np.stack([np.asarray(F, dtype=float), np.asarray(a, dtype=float)]))
+    step = float(lnh_grid[1] - lnh_grid[0]) if lnh_grid.size > 1 else 1.0
+    out = np.empty((2, lnh_grid.size))
+    for j, x0 in enumerate(lnh_grid):
+        w = np.clip(1.0 - np.abs(x - x0) / step, 0.0, None)
+        sel = w > 0.0
+        if np.count_nonzero(sel) < 3:  # sparse increments: interpolate
+            out[:, j] = [np.interp(x0, x, y) for y in Y]
+            continue
+        xs, ws = x[sel] - x0, w[sel]
+        A = np.stack([np.ones_like(xs), xs], axis=1) * ws[:, None]
+        coef, *_ = np.linalg.lstsq(A, (Y[:, sel] * ws).T, rcond=None)
+        out[:, j] = coef[0]
+    return np.exp(out[0]), np.exp(out[1])
+
+
+@dataclass(frozen=True)
+class RunCurve:
+    """One FE run resampled on the ln h grid, with its geometry and material."""
+
+    key: str
+    material: Material
+    group: str            # material label; leave-one-material-out folds group by it
+    radius: float         # R of the deformable body
+    indenter_radius: float  # R_i of the rigid surface (inf: flat)
+    rho: float            # relative radius ρ
+    h: np.ndarray
+    F: np.ndarray
+    a: np.ndarray
+    h_fe: np.ndarray = field(repr=False)  # the FE increments (for the F(h), a(h) errors)
+    F_fe: np.ndarray = field(repr=False)
+    a_fe: np.ndarray = field(repr=False)
+    a_min: float = 0.0    # resolution threshold used
+
+    @property
+    def scene(self) -> str:
+        if math.isinf(self.indenter_radius):
+            return "flat"
+        return f"sphere R_i/R={self.indenter_radius / self.radius:g}"
+
+
+def run_curve(key: str, run, per_decade: int = PER_DECADE,
+              a_min_elements: float = A_MIN_ELEMENTS) -> RunCurve | None:
+    """Resample one run (a ``spherecontact.fem.io.Run`` or anything with ``h, F, a,
+    inputs, material()``); None if no increment is resolved (a < a_min).
+    """
+    inp = run.inputs
+    R = float(inp["radius"])
+    Ri = float(inp.get("indenter_radius", math.inf))
+    density = float(inp.get("mesh_density", 1.0))
+    rho = relative_radius(R, Ri)
+    h, F, a = (np.asarray(v, dtype=float) for v in (run.h, run.F, run.a))
+    ok = (h > 0) & (F > 0) & (a > 0) & np.isfinite(h + F + a)
+    h, F, a = h[ok], F[ok], a[ok]
+    order = np.argsort(h, kind="stable")
+    h, F, a = h[order], F[order], a[order]
+    a_min = a_min_elements * POLE_ELEMENT * R / density
+    use = a >= a_min
+    if np.count_nonzero(use) < 2:
+        return None
+    lo, hi = np.log(h[use][0] / R), np.log(h[-1] / R)
+    d = math.log(10.0) / per_decade
+    k = np.arange(math.ceil(lo / d - 1e-9), math.floor(hi / d + 1e-9) + 1)
+    lng = k * d + math.log(R)
+    if lng.size < 2:
+        return None
+    Fg, ag = resample(h, F, a, lng)
+    mat = run.material()
+    return RunCurve(key=key, material=mat, group=material_label(mat), radius=R, indenter_radius=Ri,
+                    rho=rho, h=np.exp(lng), F=Fg, a=ag, h_fe=h, F_fe=F, a_fe=a, a_min=a_min)
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """Calibration points of many runs, concatenated (β-independent parts)."""
+
+    curves: tuple[RunCurve, ...]
+    run: np.ndarray    # index into ``curves`` per point
+    h: np.ndarray
+    F: np.ndarray
+    a: np.ndarray
+    rho: np.ndarray
+    R: np.ndarray
+    E_prime: np.ndarray
+    p_m: np.ndarray    # F/(π a²)
+    c2: np.ndarray     # a²/(2 h ρ)
+    x_R: np.ndarray    # a/R
+    x_rho: np.ndarray  # a/ρ
+    h_R: np.ndarray    # h/R
+
+    @property
+    def size(self) -> int:
+        return int(self.h.size)
+
+    @property
+    def groups(self) -> list[str]:
+        """Material labels, sorted (one fold each)."""
+        return sorted({c.group for c in self.curves})
+
+    def group_mask(self, group: str) -> np.ndarray:
+        g = np.array([c.group == group for c in self.curves])
+        return g[self.run]
+
+    def subset(self, keep_runs: Sequence[int]) -> Dataset:
+        """A dataset of the runs ``keep_runs`` (indices into ``curves``)."""
+        return build_dataset_from_curves([self.curves[i] for i in keep_runs])
+
+    def without_group(self, group: str) -> Dataset:
+        return self.subset([i for i, c in enumerate(self.curves) if c.group != group])
+
+    def only_group(self, group: str) -> Dataset:
+        return self.subset([i for i, c in enumerate(self.curves) if c.group == group])
+
+
+def build_dataset_from_curves(curves: Iterable[RunCurve]) -> Dataset:
+    curves = tuple(curves)
+    if not curves:
+        raise ValueError("no calibration points: no run has a resolved contact radius")
+    run = np.concatenate([np.full(c.h.size, i) for i, c in enumerate(curves)])
+    cat = lambda f: np.concatenate([f(c) for c in curves])  # noqa: E731
+    h, F, a = cat(lambda c: c.h), cat(lambda c: c.F), cat(lambda c: c.a)
+    rho = cat(lambda c: np.full(c.h.size, c.rho))
+    R = cat(lambda c: np.full(c.h.size, c.radius))
+    Ep = cat(lambda c: np.full(c.h.size, c.material.E_prime))
+    return Dataset(curves=curves, run=run, h=h, F=F, a=a, rho=rho, R=R, E_prime=Ep,
+                   p_m=F / (math.pi * a * a), c2=a * a / (2.0 * h * rho), x_R=a / R, x_rho=a / rho,
+                   h_R=h / R)
+
+
+def build_dataset(runs: Iterable[tuple[str, object]], per_decade: int = PER_DECADE,
+                  a_min_elements: float = A_MIN_ELEMENTS) -> Dataset:
+    """Dataset of ``(key, run)`` pairs; runs without resolved points are skipped."""
+    curves = []
+    for key, run in runs:
+        c = run_curve(key, run, per_decade, a_min_elements)
+        if c is not None:
+            curves.append(c)
+    return build_dataset_from_curves(curves)
+
+
+def quantities(ds: Dataset, beta: float) -> dict[str, np.ndarray]:
+    """σ_rep, Λ and H̄ of every point for the representative-strain factor β.
+
+    Returns
+    -------
+    dict with ``sigma_rep``, ``Lambda``, ``H_bar`` (NaN-free; elastic runs have
+    σ_rep = inf, Λ = 0 and H̄ = 0) and ``eps_rep``.
+    """
+    eps = beta * ds.x_rho
+    sig = np.empty_like(eps)
+    for i, c in enumerate(ds.curves):
+        m = ds.run == i
+        sig[m] = c.material.flow_stress(eps[m])
+    Lam = ds.E_prime * ds.x_rho / sig
+    with np.errstate(invalid="ignore"):
+        H = np.where(np.isfinite(sig), ds.p_m / sig, 0.0)
+    return {"eps_rep": eps, "sigma_rep": sig, "Lambda": Lam, "H_bar": H}
