@@ -12,6 +12,11 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   for q = H̄, c²;
 * Level II, t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) ∈ [0, 1]:
   q(t) = q_I + (q_III − q_I) · [t + t(1 − t) Σ_k shape[k] t^k]  (continuous at both ends);
+  with ``level_II.smooth`` (schema 2) instead the cubic Hermite that also matches the
+  slopes at both ends, plus shape terms that keep them:
+  s(t) = 3t² − 2t³ + m₀ (t − 2t² + t³) + t²(1 − t)² Σ_k shape[k] t^k, with
+  m₀ = H̄_I ln(Λ_III/Λ_I)/(H̄_III − H̄_I) for H̄ (d ln H̄/d ln Λ = 1 of Hertz at Λ_I) and
+  m₀ = 0 for c²; the slope is 0 at Λ_III. q and dq/dΛ are then continuous (F(h) is C¹);
 * finite size, geometric ratio x (a/ρ_i or a/R_i):  q → q · (1 + Σ_k coeffs[k] x^(k+1)),
   which vanishes as x → 0;
 * large-deformation collapse (schema 2, optional; same ratio x): the half-space values
@@ -249,6 +254,7 @@ class Coefficients:
     collapse_H_bar: CollapseLimit | None = None
     collapse_c2: CollapseLimit | None = None
     collapse_sharpness: float = 0.0
+    level_II_smooth: bool = False
     source: str = "literature"
     schema_version: int = SCHEMA_VERSION
     provenance: dict = field(default_factory=dict, compare=False, hash=False, repr=False)
@@ -304,7 +310,14 @@ class Coefficients:
             raise ValueError("coefficients: 'references' must be an object")
         cH = cc = None
         k = 0.0
+        smooth = False
         if version >= 2:
+            if "smooth" not in lev2:
+                raise ValueError("coefficients: missing key 'level_II.smooth' (required by "
+                                 "schema_version 2)")
+            smooth = lev2["smooth"]
+            if not isinstance(smooth, bool):
+                raise ValueError(f"coefficients: 'level_II.smooth' must be true or false, got {smooth!r}")
             if "collapse" not in d:
                 raise ValueError("coefficients: missing key 'collapse' (required by schema_version 2; "
                                  "null for none)")
@@ -324,8 +337,8 @@ class Coefficients:
                 if cc.exponent < 0.0:
                     raise ValueError(f"coefficients: 'collapse.c2.exponent' must be >= 0, "
                                      f"got {cc.exponent!r}")
-        elif "collapse" in d:
-            raise ValueError("coefficients: key 'collapse' needs schema_version 2")
+        elif "collapse" in d or "smooth" in lev2:
+            raise ValueError("coefficients: keys 'collapse' and 'level_II.smooth' need schema_version 2")
         return cls(
             beta=beta,
             Lambda_I=lam1,
@@ -345,6 +358,7 @@ class Coefficients:
             collapse_H_bar=cH,
             collapse_c2=cc,
             collapse_sharpness=k,
+            level_II_smooth=smooth,
             source=source,
             schema_version=version,
             provenance=copy.deepcopy(provenance),
@@ -370,6 +384,7 @@ class Coefficients:
                             "c2": list(self.finite_size_c2)},
         }
         if self.schema_version >= 2:
+            d["level_II"]["smooth"] = self.level_II_smooth
             d["collapse"] = None if not self.has_collapse else {
                 "H_bar": self.collapse_H_bar.to_dict(), "c2": self.collapse_c2.to_dict(),
                 "sharpness": self.collapse_sharpness}

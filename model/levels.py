@@ -7,7 +7,9 @@
 | III   | Λ ≥ Λ_III        | H̄_III(n)              | c²_III(n)              |
 
 s(t) = t + t(1 − t)·Σ_k b_k t^k (b_k: ``level_II`` shape terms; none → straight line
-in ln Λ, seed §2), so H̄ and c² are continuous at Λ_I and Λ_III. All functions are pure
+in ln Λ, seed §2), so H̄ and c² are continuous at Λ_I and Λ_III. With
+``level_II.smooth`` the shape is the cubic Hermite that also matches the slopes at
+both ends (Hertz at Λ_I, flat at Λ_III) plus t²(1 − t)²·Σ_k b_k t^k: H̄, c² are C¹. All functions are pure
 and vectorised; ``n`` is the effective hardening exponent (broadcast with Λ).
 The finite-size factor 1 + Σ_k f_k x^(k+1) multiplies H̄ and c² (x = a/ρ or a/R).
 The large-deformation collapse (:func:`collapse_blend`) then blends these half-space
@@ -49,24 +51,50 @@ def level(Lambda, coeffs: Coefficients) -> np.ndarray:
     return np.where(L <= coeffs.Lambda_I, 1, np.where(L < coeffs.Lambda_III, 2, 3))
 
 
-def _shape(t, b: tuple[float, ...]):
-    """s(t) = t + t(1−t)P(t) and s'(t), P(t) = Σ b_k t^k."""
-    if not b:
-        return t, np.ones_like(t)
+def _poly_and_derivative(t, b: tuple[float, ...]):
+    """P(t) = Σ b_k t^k and P'(t)."""
     P = np.zeros_like(t)
     dP = np.zeros_like(t)
     for c in reversed(b):
         dP = dP * t + P
         P = P * t + c
-    return t + t * (1.0 - t) * P, 1.0 + (1.0 - 2.0 * t) * P + t * (1.0 - t) * dP
+    return P, dP
 
 
-def _level_II(Lambda, q_I, q_III, coeffs: Coefficients, shape):
+def _shape(t, b: tuple[float, ...], smooth: bool = False, m0=0.0):
+    """Level II shape s(t) and s'(t) (module docstring of ``coefficients``).
+
+    Polynomial: s = t + t(1−t)P(t). Smooth: s = 3t² − 2t³ + m₀(t − 2t² + t³) + t²(1−t)²P(t),
+    with s'(0) = m₀ and s'(1) = 0.
+    """
+    if not smooth:
+        if not b:
+            return t, np.ones_like(t)
+        P, dP = _poly_and_derivative(t, b)
+        return t + t * (1.0 - t) * P, 1.0 + (1.0 - 2.0 * t) * P + t * (1.0 - t) * dP
+    u = 1.0 - t
+    s = t * t * (3.0 - 2.0 * t) + m0 * t * u * u
+    ds = 6.0 * t * u + m0 * u * (1.0 - 3.0 * t)
+    if b:
+        P, dP = _poly_and_derivative(t, b)
+        s = s + t * t * u * u * P
+        ds = ds + 2.0 * t * u * (1.0 - 2.0 * t) * P + t * t * u * u * dP
+    return s, ds
+
+
+def _m0_H(coeffs: Coefficients, H_III):
+    """Start slope of the smooth H̄ shape: Hertz's d H̄/d ln Λ = H̄_I, in units of (H̄_III − H̄_I)/L."""
+    L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
+    H_I = coeffs.H_bar_I
+    return H_I * L / (H_III - H_I)
+
+
+def _level_II(Lambda, q_I, q_III, coeffs: Coefficients, shape, m0=0.0):
     """q(Λ) in Level II and d q/d ln Λ (t clipped to [0, 1])."""
     L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
     with np.errstate(divide="ignore"):
         t = np.clip(np.log(Lambda / coeffs.Lambda_I) / L, 0.0, 1.0)
-    s, ds = _shape(t, shape)
+    s, ds = _shape(t, shape, coeffs.level_II_smooth, m0)
     return q_I + (q_III - q_I) * s, (q_III - q_I) * ds / L
 
 
@@ -83,8 +111,9 @@ def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_I
     with np.errstate(divide="ignore"):
         t = np.clip(np.log(Lam / lam1) / L, 0.0, 1.0)
     H_I = coeffs.H_bar_I
-    sH_t, dsH_t = _shape(t, coeffs.H_bar_shape)
-    sc_t, dsc_t = _shape(t, coeffs.c2_shape)
+    sm = coeffs.level_II_smooth
+    sH_t, dsH_t = _shape(t, coeffs.H_bar_shape, sm, _m0_H(coeffs, H_III) if sm else 0.0)
+    sc_t, dsc_t = _shape(t, coeffs.c2_shape, sm, 0.0)
     H2 = H_I + (H_III - H_I) * sH_t
     c2_2 = C2_HERTZ + (c2_III - C2_HERTZ) * sc_t
     one, two = lev == 1, lev == 2
@@ -103,7 +132,8 @@ def H_bar_and_slope(Lambda, coeffs: Coefficients, n=0.0):
     Lam, n = np.broadcast_arrays(np.asarray(Lambda, dtype=float), np.asarray(n, dtype=float))
     H_I = coeffs.H_bar_I
     H_III = coeffs.H_bar_III(n)
-    H2, dH2 = _level_II(Lam, H_I, H_III, coeffs, coeffs.H_bar_shape)
+    m0 = _m0_H(coeffs, H_III) if coeffs.level_II_smooth else 0.0
+    H2, dH2 = _level_II(Lam, H_I, H_III, coeffs, coeffs.H_bar_shape, m0)
     lev = level(Lam, coeffs)
     H = np.where(lev == 1, _HERTZ * Lam, np.where(lev == 2, H2, H_III))
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -21,6 +21,7 @@ COLLAPSE = {
 def v2(collapse=COLLAPSE, ratio="a_over_R") -> Coefficients:
     d = LIT.to_dict()
     d["schema_version"] = 2
+    d["level_II"]["smooth"] = False
     d["collapse"] = copy.deepcopy(collapse)
     d["finite_size"] = {"ratio": ratio, "H_bar": [0.3], "c2": [0.1]}
     return Coefficients.from_dict(d)
@@ -61,6 +62,7 @@ def test_schema_1_file_with_collapse_is_rejected():
 def test_null_collapse_equals_schema_1_model():
     d = LIT.to_dict()
     d["schema_version"] = 2
+    d["level_II"]["smooth"] = False
     d["collapse"] = None
     co = Coefficients.from_dict(d)
     m = Material(E=300.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)
@@ -125,3 +127,50 @@ def test_model_with_collapse_hertz_limit_and_fast_path(ratio):
         hs = np.geomspace(1e-6, 0.3, 50)
         F, k = law.force(hs)
         assert np.all(np.diff(F) > 0) and np.all(k > 0)
+
+
+def smooth(H_shape=(0.4, -0.2), c2_shape=(0.3,)) -> Coefficients:
+    d = v2().to_dict()
+    d["level_II"] = {"H_bar_shape": list(H_shape), "c2_shape": list(c2_shape), "smooth": True}
+    return Coefficients.from_dict(d)
+
+
+def test_smooth_level_II_is_C1_at_both_boundaries():
+    co = smooth()
+    for n in (0.0, 0.2):
+        for L0 in (co.Lambda_I, co.Lambda_III):
+            L = L0 * np.exp(np.array([-1e-7, 1e-7]))
+            H, sH = levels.H_bar_and_slope(L, co, n)
+            c, sc = levels.c2_and_slope(L, co, n)
+            np.testing.assert_allclose(H[0], H[1], rtol=1e-6)
+            np.testing.assert_allclose(sH[0], sH[1], atol=1e-5)
+            np.testing.assert_allclose(c[0], c[1], rtol=1e-6)
+            np.testing.assert_allclose(sc[0], sc[1], atol=1e-5)
+    # inside Level II: slopes are the derivatives of the values
+    L = np.geomspace(co.Lambda_I * 1.01, co.Lambda_III * 0.99, 20)
+    H, sH = levels.H_bar_and_slope(L, co, 0.1)
+    H2, _ = levels.H_bar_and_slope(L * (1 + 1e-7), co, 0.1)
+    np.testing.assert_allclose(np.log(H2 / H) / 1e-7, sH, atol=1e-5)
+    c, sc = levels.c2_and_slope(L, co, 0.1)
+    c2b, _ = levels.c2_and_slope(L * (1 + 1e-7), co, 0.1)
+    np.testing.assert_allclose(np.log(c2b / c) / 1e-7, sc, atol=1e-5)
+
+
+def test_smooth_level_II_stiffness_is_continuous():
+    co = smooth()
+    m = Material(E=100.0, nu=0.3, sigma_y=1.0)
+    law = BodyLaw(m, co)
+    # Λ = E' x/σ_Y: x at both level boundaries
+    for lam in (co.Lambda_I, co.Lambda_III):
+        x = lam / m.E_prime * np.exp(np.array([-1e-7, 1e-7]))
+        r = law.response(x)
+        np.testing.assert_allclose(r.dlnp_dlnx[0], r.dlnp_dlnx[1], atol=1e-5)
+        np.testing.assert_allclose(r.dlnc2_dlnx[0], r.dlnc2_dlnx[1], atol=1e-5)
+    assert Coefficients.from_dict(co.to_dict()) == co
+    d = co.to_dict()
+    d["level_II"]["smooth"] = "yes"
+    with pytest.raises(ValueError, match=r"level_II\.smooth"):
+        Coefficients.from_dict(d)
+    d["level_II"].pop("smooth")
+    with pytest.raises(ValueError, match=r"level_II\.smooth"):
+        Coefficients.from_dict(d)
