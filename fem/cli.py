@@ -20,7 +20,7 @@ import numpy as np
 
 from ..model.material import Material
 from .assembly import ELEMENTS
-from .io import check_inputs, run_indentation, write_run
+from .io import SCENES, check_inputs, run_indentation, write_run
 from .mesh import DENSITY_RANGE
 from .solver import SolverOptions
 
@@ -76,6 +76,34 @@ def material_from_args(args: argparse.Namespace) -> Material:
                     K=0.0 if args.K is None else args.K, n=1.0 if args.n is None else args.n)
 
 
+BODY2_FLAGS = {"radius2": "--radius2", "E2": "--E2", "nu2": "--nu2", "sigma_y2": "--sigma-y2",
+               "K2": "--K2", "n2": "--n2"}
+
+
+def material2_from_args(args: argparse.Namespace, material: Material) -> Material | None:
+    """Body 2 from --E2/--nu2/--sigma-y2/--K2/--n2 (each defaults to body 1's value);
+    None when no body-2 flag is given. --E2 inf makes body 2 rigid."""
+    given = {k: getattr(args, k, None) for k in BODY2_FLAGS}
+    if all(v is None for v in given.values()):
+        return None
+    E2 = args.E if given["E2"] is None else given["E2"]
+    nu2 = args.nu if given["nu2"] is None else given["nu2"]
+    if math.isinf(E2) and E2 > 0:
+        return Material.rigid()
+    plastic = [given[k] for k in ("sigma_y2", "K2", "n2")]
+    if material.is_tabulated and all(v is None for v in plastic):
+        return Material.from_table(E2, nu2, material.eps_table, material.sigma_table)
+    if material.is_tabulated:
+        defaults = (math.inf, 0.0, 1.0)
+    else:
+        defaults = (material.sigma_y, material.K, material.n)
+    sy, K, n = (d if v is None else v for v, d in zip(plastic, defaults, strict=True))
+    try:
+        return Material(E=E2, nu=nu2, sigma_y=sy, K=K, n=n)
+    except ValueError as err:
+        raise ValueError(f"body 2 (--E2/--nu2/--sigma-y2/--K2/--n2): {err}") from None
+
+
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
     """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
     --strain-increment, --max-wall-s and --no-line-search."""
@@ -128,13 +156,21 @@ def run_command(args: argparse.Namespace) -> int:
     material = material_from_args(args)
     options = options_from_args(args)
     out = _check_output(args.out)
-    check_inputs(material, args.radius, args.h_max, args.indenter_radius, args.mesh_density,
-                 args.element, options)
+    material2 = material2_from_args(args, material)
+    radius2 = args.radius2
+    if material2 is not None and radius2 is None:
+        radius2 = args.radius
+    checked = check_inputs(material, args.radius, args.h_max, args.indenter_radius,
+                           args.mesh_density, args.element, options, radius2=radius2,
+                           material2=material2, scene=args.scene.replace("-", "_"))
+    print(f"scene: {checked['scene']} ({SCENES[checked['scene']]})", file=sys.stderr)
     bar = _Progress(args.h_max, args.quiet)
     try:
         result = run_indentation(material, args.radius, args.h_max,
                                  indenter_radius=args.indenter_radius, density=args.mesh_density,
-                                 element=args.element, options=options, progress=bar)
+                                 element=args.element, options=options, progress=bar,
+                                 radius2=radius2, material2=material2,
+                                 scene=args.scene.replace("-", "_"))
     finally:
         bar.close()
     extra = {"entry_point": "spherecontact fem run",
@@ -169,10 +205,23 @@ def _add_geometry(add) -> None:
     grp = "geometry and loading (lengths in the unit of --radius)"
     add(grp, "--radius", type=float, default=1.0, help="sphere radius R, finite > 0 (default 1)")
     add(grp, "--h-max", type=float, required=True,
-        help="final approach h (shortening pole to equatorial plane), in (0, 0.8 R]")
+        help="final approach h = h1 + h2 (shortening between the two bodies' equatorial "
+             "planes), in (0, 0.8 min(R, R2)] (equal pairs: (0, 1.6 R])")
     add(grp, "--indenter-radius", type=float, default=math.inf, metavar="R2",
         help="radius of a rigid spherical indenter, > 0 (default inf: rigid flat, i.e. two "
              "equal spheres by symmetry)")
+    grp2 = "body 2 (any of these makes a pair; each defaults to body 1's value)"
+    add(grp2, "--radius2", type=float, default=None,
+        help="radius of body 2, > 0 (inf: a flat, which must then be rigid)")
+    add(grp2, "--E2", type=float, default=None, help="Young's modulus of body 2, > 0 (inf: rigid)")
+    add(grp2, "--nu2", type=float, default=None, help="Poisson's ratio of body 2, in (-1, 0.5)")
+    add(grp2, "--sigma-y2", type=float, default=None, help="yield stress of body 2, > 0")
+    add(grp2, "--K2", type=float, default=None, help="Ludwik hardening modulus of body 2, >= 0")
+    add(grp2, "--n2", type=float, default=None, help="Ludwik hardening exponent of body 2, >= 0")
+    add(grp2, "--scene", choices=("auto", "two-body"), default="auto",
+        help="auto (default): the cheapest exact scene (rigid partner: one hemisphere on a rigid "
+             "flat or sphere; equal bodies: one hemisphere on a flat by symmetry; otherwise two "
+             "hemispheres); two-body: always two deformable hemispheres")
 
 
 def _add_numerics(add) -> None:

@@ -44,9 +44,11 @@ from .assembly import ELEMENTS
 from .contact import RigidObstacle
 from .mesh import DENSITY_RANGE
 from .solver import IndentationSolver, RunResult, SolverOptions
+from .twobody import TwoBodySolver
 
 __all__ = [
-    "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "Run", "check_inputs", "run_indentation",
+    "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "SCENES", "Run", "check_inputs", "choose_scene",
+    "run_indentation",
     "write_run", "write_run_group", "read_run", "run_from_group", "provenance",
 ]
 
@@ -78,6 +80,22 @@ CURVES = {
     "dissipation": ("energy", "plastic dissipation"),
     "iterations": ("count", "Newton iterations of the increment"),
     "active_changes": ("count", "contact active-set changes in the increment"),
+    "h1": ("length", "approach of body 1: shortening of its equator-to-pole distance"),
+    "h2": ("length", "approach of body 2 (0 for a rigid partner); h = h1 + h2"),
+    "interface_curvature": ("1/length", "curvature of the deformed interface at the axis "
+                            "(body 1's own surface: +1/R1; a flat interface: 0)"),
+    "dissipation_1": ("energy", "plastic dissipation in body 1"),
+    "dissipation_2": ("energy", "plastic dissipation in body 2"),
+    "eps_p_max_1": ("1", "largest equivalent plastic strain in body 1"),
+    "eps_p_max_2": ("1", "largest equivalent plastic strain in body 2"),
+}
+#: scenes: how a pair of bodies is modelled (the cheapest exact one is chosen)
+SCENES = {
+    "rigid_flat": "one hemisphere on a rigid flat",
+    "rigid_sphere": "one hemisphere on a rigid sphere",
+    "equal_pair_symmetry": "two equal spheres as one hemisphere on a rigid flat (the mid-plane "
+                           "is a symmetry plane); h = 2 x the hemisphere's approach",
+    "two_body": "two deformable hemispheres in node-to-surface contact",
 }
 #: curves every run file must hold
 REQUIRED_CURVES = ("h", "F", "F_support", "a", "a_nodes", "a_ref", "p_m", "eps_p_max",
@@ -103,26 +121,88 @@ def _as_float(value) -> float:
         return math.nan
 
 
+def _check_body2(material, R, material2, radius2, indenter_radius) -> tuple[Material | None, float]:
+    """Body 2 of a pair (defaults: body 1's material and radius); errors for impossible pairs."""
+    if material2 is None and radius2 is None:
+        return None, math.nan
+    if not math.isinf(_as_float(indenter_radius)):
+        raise ValueError("give either indenter_radius (a rigid sphere) or body 2 "
+                         "(radius2/material2), not both")
+    if material2 is None:
+        material2 = material
+    if not isinstance(material2, Material):
+        raise ValueError(f"material2 must be a Material, got {type(material2).__name__}")
+    R2 = R if radius2 is None else _as_float(radius2)
+    if math.isnan(R2) or R2 == 0.0:
+        raise ValueError(f"radius2 must be > 0 (inf for a flat), got {radius2!r}")
+    if R2 < 0.0:
+        what = (f"a concave seat of radius {-R2:g} is smaller than the sphere (radius {R:g}): "
+                "the bodies would overlap initially" if -R2 < R else
+                "concave partners (radius2 < 0) are not supported")
+        raise ValueError(f"radius2 = {R2:g} < 0: {what}; radius2 must be > 0 (inf for a flat)")
+    if material2.is_rigid:
+        return material2, R2
+    if math.isinf(R2):
+        raise ValueError("radius2 = inf with a deformable material2 (a deformable flat block) is "
+                         "not supported; use a rigid flat (E2 = inf) or a finite radius2")
+    return material2, R2
+
+
+def choose_scene(material, radius, material2=None, radius2=None,
+                 indenter_radius=math.inf, scene="auto") -> str:
+    """The cheapest exact scene for the inputs (a key of :data:`SCENES`).
+
+    No body 2 or a rigid body 2: one hemisphere on a rigid flat or sphere; equal
+    deformable bodies: one hemisphere on a flat (symmetry); otherwise two bodies.
+    ``scene = "two_body"`` forces two deformable bodies (equal pairs too).
+    """
+    if scene not in ("auto", "two_body"):
+        raise ValueError(f"scene must be 'auto' or 'two_body', got {scene!r}")
+    if material2 is None or material2.is_rigid:
+        if scene == "two_body":
+            raise ValueError("scene 'two_body' needs a deformable body 2 (material2 with finite E)")
+        R2 = indenter_radius if material2 is None else radius2
+        return "rigid_flat" if math.isinf(_as_float(R2)) else "rigid_sphere"
+    if scene == "auto" and radius2 == radius and material2.describe() == material.describe():
+        return "equal_pair_symmetry"
+    return "two_body"
+
+
 def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
-                 element="q8r", options=None, progress=None) -> dict:
+                 element="q8r", options=None, progress=None, radius2=None, material2=None,
+                 scene="auto") -> dict:
     """Validate every input of :func:`run_indentation`; return them normalised.
 
     Raises ValueError naming the parameter and its allowed range.
     """
     if not isinstance(material, Material):
         raise ValueError(f"material must be a Material, got {type(material).__name__}")
+    rigid2 = isinstance(material2, Material) and material2.is_rigid
     if material.is_rigid:
-        raise ValueError("material: the deformable sphere must not be rigid (E = inf)")
+        raise ValueError("both bodies are rigid: nothing deforms; material (body 1) must have "
+                         "a finite E" if rigid2 else
+                         "material: the deformable sphere must not be rigid (E = inf)")
     R = _as_float(radius)
+    if math.isinf(R) and R > 0 and radius2 is not None and math.isinf(_as_float(radius2)):
+        raise ValueError("radius = radius2 = inf: two flats have no contact point; radius "
+                         "(body 1) must be a finite number > 0")
     if not (math.isfinite(R) and R > 0.0):
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
+    material2, R2 = _check_body2(material, R, material2, radius2, indenter_radius)
+    chosen = choose_scene(material, R, material2, R2, indenter_radius, scene)
+    R_min = min(R, R2) if chosen == "two_body" else R
+    reach = 1.6 * R if chosen == "equal_pair_symmetry" else 0.8 * R_min
+    what = {"two_body": "0.8 min(radius, radius2)", "equal_pair_symmetry": "1.6 radius"}.get(
+        chosen, "0.8 radius")
     h = _as_float(h_max)
-    if not (math.isfinite(h) and 0.0 < h <= 0.8 * R):
-        raise ValueError(f"h_max must lie in (0, 0.8 radius] = (0, {0.8 * R:g}], got {h_max!r}")
-    R2 = _as_float(indenter_radius)
-    if not R2 > 0.0:
+    if not (math.isfinite(h) and 0.0 < h <= reach):
+        raise ValueError(f"h_max must lie in (0, {what}] = (0, {reach:g}], got {h_max!r}")
+    R_ind = _as_float(indenter_radius)
+    if not R_ind > 0.0:
         raise ValueError(
             f"indenter_radius must be > 0 (inf for a rigid flat), got {indenter_radius!r}")
+    if chosen in ("rigid_flat", "rigid_sphere") and material2 is not None:
+        R_ind = R2
     lo, hi = DENSITY_RANGE
     d = _as_float(density)
     if not (math.isfinite(d) and lo <= d <= hi):
@@ -135,28 +215,75 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
     options.validate()
     if progress is not None and not callable(progress):
         raise ValueError("progress must be a callable progress(h) or None")
-    return {"material": material, "radius": R, "h_max": h, "indenter_radius": R2,
-            "density": d, "element": element, "options": options, "progress": progress}
+    return {"material": material, "radius": R, "h_max": h, "indenter_radius": R_ind,
+            "density": d, "element": element, "options": options, "progress": progress,
+            "material2": material2, "radius2": R2, "scene": chosen}
+
+
+def _with_pair_curves(result: RunResult, scene: str) -> RunResult:
+    """Add h1, h2 (and per-body curves) to a one-hemisphere result; map the symmetric pair."""
+    c = result.curves
+    h = c["h"]
+    zeros = np.zeros_like(h)
+    result.inputs["scene"] = scene
+    if scene != "equal_pair_symmetry":
+        c.update(h1=h.copy(), h2=zeros, dissipation_1=c["dissipation"].copy(), dissipation_2=zeros,
+                 eps_p_max_1=c["eps_p_max"].copy(), eps_p_max_2=zeros,
+                 interface_curvature=np.where(c["a"] > 0, -1.0 / result.inputs["indenter_radius"],
+                                              np.nan))
+        return result
+    # the mirror image below the flat is body 2: approaches and energies double
+    half = h.copy()
+    c.update(h=2.0 * half, h1=half, h2=half.copy(), dissipation_1=c["dissipation"].copy(),
+             dissipation_2=c["dissipation"].copy(), eps_p_max_1=c["eps_p_max"].copy(),
+             eps_p_max_2=c["eps_p_max"].copy(), interface_curvature=np.where(c["a"] > 0, 0.0, np.nan))
+    for k in ("work_external", "energy_elastic", "dissipation"):
+        c[k] = 2.0 * c[k]
+    result.inputs.update(h_max=2.0 * result.inputs["h_max"], radius2=result.inputs["radius"],
+                         material2=result.inputs["material"])
+    return result
 
 
 def run_indentation(material: Material, radius: float, h_max: float,
                     indenter_radius: float = math.inf, density: float = 1.0,
                     element: str = "q8r", options: SolverOptions | None = None,
-                    progress: Callable[[float], object] | None = None) -> RunResult:
-    """Press a hemisphere of ``radius`` and ``material`` on a rigid obstacle up to ``h_max``.
+                    progress: Callable[[float], object] | None = None,
+                    radius2: float | None = None, material2: Material | None = None,
+                    scene: str = "auto") -> RunResult:
+    """Press a hemisphere of ``radius`` and ``material`` on its partner up to ``h_max``.
 
-    ``indenter_radius = inf`` is a rigid flat (equal spheres by symmetry), a finite
-    value a rigid sphere. ``density`` scales the mesh (``DENSITY_RANGE``), ``element``
-    is ``"q8r"`` (8-node, reduced integration) or ``"q4"`` (bilinear, locks).
-    Every input is checked before any mesh is built; ``progress(h)`` is called
-    after each converged increment. Returns the solver's ``RunResult``.
+    Partner: ``indenter_radius`` (rigid flat for inf, else a rigid sphere), or body 2
+    given by ``radius2`` and/or ``material2`` (the missing one equals body 1's).
+    The cheapest exact scene is chosen (:func:`choose_scene`, :data:`SCENES`;
+    ``scene="two_body"`` forces two deformable bodies) and recorded in
+    ``result.inputs["scene"]``; h is the total approach h1 + h2 of the pair.
+    ``density`` scales the mesh (``DENSITY_RANGE``), ``element`` is ``"q8r"``
+    (8-node, reduced integration) or ``"q4"`` (bilinear, locks). Every input is
+    checked before any mesh is built; ``progress(h)`` is called after each
+    converged increment. Returns the solver's ``RunResult``.
     """
     a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
-                     progress)
+                     progress, radius2, material2, scene)
+    chosen = a["scene"]
+    if chosen == "two_body":
+        solver = TwoBodySolver(a["material"], a["radius"], a["material2"], a["radius2"],
+                               density=a["density"], element=a["element"], options=a["options"])
+        return solver.run(a["h_max"], progress=a["progress"])
+    h_run, progress = a["h_max"], a["progress"]
+    if chosen == "equal_pair_symmetry":
+        h_run = 0.5 * h_run
+        if progress is not None:
+            outer = progress
+
+            def progress(h):
+                return outer(2.0 * h)
     solver = IndentationSolver(a["material"], a["radius"],
                                obstacle=RigidObstacle(a["indenter_radius"]),
                                density=a["density"], element=a["element"], options=a["options"])
-    return solver.run(a["h_max"], progress=a["progress"])
+    result = _with_pair_curves(solver.run(h_run, progress=progress), chosen)
+    if a["material2"] is not None and a["material2"].is_rigid:
+        result.inputs.update(material2=a["material2"].describe(), radius2=a["radius2"])
+    return result
 
 
 # ============================================================================ provenance
@@ -389,6 +516,15 @@ def write_run(path, result: RunResult, extra_provenance: dict | None = None) -> 
 
 
 # ============================================================================ reading
+def material_from_description(m: dict) -> Material:
+    """Inverse of ``Material.describe()``."""
+    if "eps_table" in m:
+        return Material.from_table(m["E"], m["nu"], m["eps_table"], m["sigma_table"])
+    if math.isinf(m["E"]):
+        return Material.rigid()
+    return Material(E=m["E"], nu=m["nu"], sigma_y=m["sigma_y"], K=m["K"], n=m["n"])
+
+
 @dataclass(frozen=True, eq=False)
 class Run:
     """One run read back from disk.
@@ -447,10 +583,29 @@ class Run:
 
     def material(self) -> Material:
         """The sphere's material, rebuilt from the stored inputs."""
-        m = self.inputs["material"]
-        if "eps_table" in m:
-            return Material.from_table(m["E"], m["nu"], m["eps_table"], m["sigma_table"])
-        return Material(E=m["E"], nu=m["nu"], sigma_y=m["sigma_y"], K=m["K"], n=m["n"])
+        return material_from_description(self.inputs["material"])
+
+    def material2(self) -> Material | None:
+        """Body 2's material (None when the partner was given as a rigid indenter_radius)."""
+        m = self.inputs.get("material2")
+        return None if m is None else material_from_description(m)
+
+    @property
+    def scene(self) -> str:
+        """How the pair was modelled (a key of SCENES; older files: from the indenter)."""
+        default = "rigid_flat" if math.isinf(self.inputs.get("indenter_radius", math.inf)) \
+            else "rigid_sphere"
+        return self.inputs.get("scene", default)
+
+    @property
+    def h1(self) -> np.ndarray:
+        """Approach of body 1 (h itself for files written before h1 was recorded)."""
+        return self.curves.get("h1", self.curves["h"])
+
+    @property
+    def h2(self) -> np.ndarray:
+        """Approach of body 2 (0 for a rigid partner)."""
+        return self.curves.get("h2", np.zeros_like(self.curves["h"]))
 
     def solver_options(self) -> SolverOptions:
         """The solver options, rebuilt from the stored inputs (unknown keys ignored)."""

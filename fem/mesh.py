@@ -68,11 +68,12 @@ def check_density(density: float) -> float:
     return d
 
 
-def _gmsh_quad8(radius: float, density: float, linear: bool) -> tuple[np.ndarray, np.ndarray]:
+def _gmsh_quad8(radius: float, density: float, linear: bool,
+                contact_scale: float) -> tuple[np.ndarray, np.ndarray]:
     """Run gmsh; return node coordinates (2, n) and quad connectivity (n_per_el, n_el)."""
     import gmsh
 
-    R = radius
+    R, L = radius, contact_scale
     gmsh.initialize(interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
@@ -92,8 +93,8 @@ def _gmsh_quad8(radius: float, density: float, linear: bool) -> tuple[np.ndarray
         field.setNumbers(d_pole, "PointsList", [pole])
         t_pole = field.add("Threshold")
         field.setNumber(t_pole, "InField", d_pole)
-        for key, val in (("SizeMin", SIZE_POLE * R / density), ("SizeMax", SIZE_BULK * R / density),
-                         ("DistMin", _POLE_DIST * R), ("DistMax", 0.6 * R)):
+        for key, val in (("SizeMin", SIZE_POLE * L / density), ("SizeMax", SIZE_BULK * R / density),
+                         ("DistMin", _POLE_DIST * L), ("DistMax", 0.6 * L)):
             field.setNumber(t_pole, key, val)
         d_arc = field.add("Distance")
         field.setNumbers(d_arc, "CurvesList", [arc])
@@ -103,8 +104,23 @@ def _gmsh_quad8(radius: float, density: float, linear: bool) -> tuple[np.ndarray
         for key, val in (("SizeMin", SIZE_ARC * R / density), ("SizeMax", SIZE_BULK * R / density),
                          ("DistMin", 0.03 * R), ("DistMax", 0.4 * R)):
             field.setNumber(t_arc, key, val)
+        fields = [t_pole, t_arc]
+        if L < R:  # a larger partner: the arc band of the smaller sphere's size near the pole
+            t_near = field.add("Threshold")
+            field.setNumber(t_near, "InField", d_arc)
+            for key, val in (("SizeMin", SIZE_ARC * L / density), ("SizeMax", SIZE_BULK * R / density),
+                             ("DistMin", 0.03 * L), ("DistMax", 0.4 * L)):
+                field.setNumber(t_near, key, val)
+            t_zone = field.add("Threshold")
+            field.setNumber(t_zone, "InField", d_pole)
+            for key, val in (("SizeMin", 0.0), ("SizeMax", SIZE_BULK * R / density),
+                             ("DistMin", 1.2 * L), ("DistMax", 2.0 * L)):
+                field.setNumber(t_zone, key, val)
+            near = field.add("Max")
+            field.setNumbers(near, "FieldsList", [t_near, t_zone])
+            fields.append(near)
         both = field.add("Min")
-        field.setNumbers(both, "FieldsList", [t_pole, t_arc])
+        field.setNumbers(both, "FieldsList", fields)
         field.setAsBackgroundMesh(both)
         for key, val in (("Mesh.MeshSizeExtendFromBoundary", 0), ("Mesh.MeshSizeFromPoints", 0),
                          ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.Algorithm", 8),
@@ -138,7 +154,8 @@ def _gmsh_quad8(radius: float, density: float, linear: bool) -> tuple[np.ndarray
     return X, t
 
 
-def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False) -> HemisphereMesh:
+def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
+               contact_scale: float | None = None) -> HemisphereMesh:
     """Graded all-quad meshing of the hemisphere's meridian section.
 
     Parameters
@@ -147,12 +164,17 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False) 
     density : mesh-density factor in ``DENSITY_RANGE``; element sizes scale as 1/density.
     linear : 4-node quads (straight edges) instead of 8-node serendipity quads;
         only for the locking demonstration.
+    contact_scale : length that sets the pole zone (default R). A sphere pressed
+        by a smaller partner of radius R₁ < R gets R₁ here: its contact zone is
+        as small as the partner's, so it gets the partner's pole and arc sizes
+        within about 1.2 R₁ of the pole, and its own coarser ones beyond.
     """
     radius = float(radius)
     if not np.isfinite(radius) or radius <= 0:
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
     density = check_density(density)
-    Xg, tg = _gmsh_quad8(radius, density, linear)
+    scale = radius if contact_scale is None else min(float(contact_scale), radius)
+    Xg, tg = _gmsh_quad8(radius, density, linear, scale)
     if linear:
         mesh = skfem.MeshQuad1(Xg, tg)
         basis_mesh = mesh

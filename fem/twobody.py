@@ -87,8 +87,9 @@ class TwoBodySolver:
         self.options = options or SolverOptions()
         self.options.validate()
         t0 = time.perf_counter()
-        discs = [Discretisation(build_mesh(R, density, linear=(element == "q4")), element)
-                 for R in (radius1, radius2)]
+        R_min = min(radius1, radius2)
+        discs = [Discretisation(build_mesh(R, density, linear=(element == "q4"), contact_scale=R_min),
+                                element) for R in (radius1, radius2)]
         self.t_setup = time.perf_counter() - t0
         self.bodies = [Body(material1, float(radius1), discs[0], 0, False),
                        Body(material2, float(radius2), discs[1], discs[0].n_dofs, True)]
