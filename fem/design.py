@@ -306,7 +306,9 @@ def _expand(entry: dict, where: str) -> list[dict]:
 
 def _cases_of_set(set_name: str, entries, defaults: dict) -> list[Case]:
     if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
-        raise ValueError(f"set {set_name!r} must be an array of tables ([[{set_name}]])")
+        hint = "; parameters go in [defaults] or in entries" if set_name in PARAMETERS else ""
+        raise ValueError(f"top-level key {set_name!r} must be a set, an array of tables "
+                         f"([[{set_name}]]){hint}")
     cases = []
     for i, entry in enumerate(entries, start=1):
         where = f"[[{set_name}]] entry {i}"
