@@ -1,0 +1,223 @@
+"""Verification of the two-deformable-body scene (DESIGN §4).
+
+``python -m spherecontact.fem.verification_pair [--quick] [--reuse] [--out DIR]``
+runs the cases below, writes ``DIR/pair_verification.json``, ``DIR/pair.md`` and
+``DIR/pair.png``. σ_Y = 1, R₁ = 1 throughout.
+
+* ``equal``: an equal elastic–perfectly plastic pair (E/σY = 200, ν = 0.3) as two
+  hemispheres against one hemisphere on a rigid flat (the symmetric scene), up
+  to a per-body approach h/R = 0.3: F and a within 0.5 %.
+* ``hertz``: elastic E₂/E₁ = 3, R₂/R₁ = 2, ν = 0.3/0.2: F against the reference
+  contact radius within 1 % of Hertz with E*, R* (Hertz 1882) for a/R₁ 0.01–0.05,
+  and h₁/h₂ against E'₂/E'₁ (the half-space centre displacements
+  π p₀ a/(2E'ᵢ); Johnson 1985 §4.2), within 2 % at small h.
+* ``stiff``: a plastic body 1 (EPP E/σY = 200) against an elastic body 2 with
+  E₂/E₁ = 1000, against the rigid-sphere scene (R₂ = R₁), to h/R = 0.3: within 1 %.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+
+from ..model.material import Material
+from .io import run_indentation
+
+NU = 0.3
+EPP = Material(E=200.0, nu=NU, sigma_y=1.0, K=0.0, n=1.0)
+
+
+def _cases(quick: bool) -> dict:
+    """name → keyword arguments of run_indentation (h_max shortened and meshes coarse in quick mode)."""
+    d = 0.5 if quick else 1.0
+    h_equal, h_stiff = (0.06, 0.06) if quick else (0.3, 0.3)
+    return {
+        "equal_two_body": dict(material=EPP, radius=1.0, h_max=2 * h_equal, radius2=1.0,
+                               material2=EPP, scene="two_body", density=d),
+        "equal_flat": dict(material=EPP, radius=1.0, h_max=h_equal, density=d),
+        "hertz": dict(material=Material.elastic(200.0, 0.3), radius=1.0, h_max=0.004, radius2=2.0,
+                      material2=Material.elastic(600.0, 0.2), density=d),
+        "stiff_two_body": dict(material=EPP, radius=1.0, h_max=h_stiff, radius2=1.0,
+                               material2=Material.elastic(200.0 * 1000, NU), density=d),
+        "stiff_rigid": dict(material=EPP, radius=1.0, h_max=h_stiff, indenter_radius=1.0, density=d),
+    }
+
+
+def _run(name: str, kwargs: dict, outdir: Path) -> dict:
+    """One run, saved as JSON next to the report (nothing finished is lost)."""
+    t0 = time.perf_counter()
+    res = run_indentation(**kwargs)
+    out = {"curves": {k: np.asarray(v).tolist() for k, v in res.curves.items()},
+           "status": res.status, "reason": res.reason, "scene": res.inputs["scene"],
+           "timings": {k: float(v) for k, v in res.timings.items()},
+           "n_dofs": int(res.inputs["n_dofs"]), "wall_s": time.perf_counter() - t0}
+    tmp = outdir / f".pair_{name}.json.tmp"
+    tmp.write_text(json.dumps(out))
+    os.replace(tmp, outdir / f"pair_{name}.json")
+    return out
+
+
+def _curve(run: dict, key: str) -> np.ndarray:
+    return np.asarray(run["curves"][key], dtype=float)
+
+
+def _rel_on(ref: dict, other: dict, key: str, x_ref: np.ndarray, x_other: np.ndarray,
+            window: tuple[float, float]) -> np.ndarray:
+    """Relative difference of ``other`` against ``ref`` in ``key``, at ref's points in the window."""
+    xr, yr = x_ref, _curve(ref, key)
+    sel = (xr >= window[0]) & (xr <= window[1]) & (yr > 0)
+    return np.interp(xr[sel], x_other, _curve(other, key)) / yr[sel] - 1.0
+
+
+def evaluate(runs: dict, quick: bool) -> dict:
+    """The figures of the three checks."""
+    fig = {}
+    # equal pair: two bodies (h = 2 × per-body approach) against the symmetric scene
+    two, flat = runs["equal_two_body"], runs["equal_flat"]
+    h_end = _curve(flat, "h")[-1]
+    win = (0.01, h_end)
+    dF = _rel_on(flat, two, "F", _curve(flat, "h"), _curve(two, "h1"), win)
+    da = _rel_on(flat, two, "a", _curve(flat, "h"), _curve(two, "h1"), win)
+    h1, h2 = _curve(two, "h1"), _curve(two, "h2")
+    fig["equal"] = {"window_h_over_R": list(win), "F_max_pct": 100 * float(np.abs(dF).max()),
+                    "F_rms_pct": 100 * float(np.sqrt(np.mean(dF**2))),
+                    "a_max_pct": 100 * float(np.abs(da).max()),
+                    "a_rms_pct": 100 * float(np.sqrt(np.mean(da**2))),
+                    "h1_h2_max_dev_pct": 100 * float(np.abs(h1[h2 > 0] / h2[h2 > 0] - 1).max()),
+                    "wall_two_body_s": two["wall_s"], "wall_flat_s": flat["wall_s"],
+                    "dofs_two_body": two["n_dofs"], "dofs_flat": flat["n_dofs"]}
+    # elastic dissimilar pair against Hertz with E*, R*
+    hz = runs["hertz"]
+    m1, m2 = Material.elastic(200.0, 0.3), Material.elastic(600.0, 0.2)
+    Es = 1.0 / (1.0 / m1.E_prime + 1.0 / m2.E_prime)
+    Rs = 1.0 / (1.0 + 1.0 / 2.0)
+    F, a_ref, a = _curve(hz, "F"), _curve(hz, "a_ref"), _curve(hz, "a")
+    sel = (a_ref >= 0.01) & (a_ref <= 0.05)
+    ratio_F = F[sel] / (4.0 * Es * a_ref[sel] ** 3 / (3.0 * Rs))
+    target = m2.E_prime / m1.E_prime
+    rh = _curve(hz, "h1") / _curve(hz, "h2") / target
+    small = a <= 0.02
+    fig["hertz"] = {"E_star": Es, "R_star": Rs, "a_window": [0.01, 0.05],
+                    "F_vs_a_max_pct": 100 * float(np.abs(ratio_F - 1).max()),
+                    "F_vs_a_mean_pct": 100 * float(np.mean(ratio_F - 1)),
+                    "h1_over_h2_target": target,
+                    "h1_over_h2_dev_pct_small_h": 100 * float(np.abs(rh[small] - 1).max()),
+                    "h1_over_h2_dev_pct_all": 100 * float(np.abs(rh - 1).max()),
+                    "a_small_h_max": 0.02, "wall_s": hz["wall_s"]}
+    # stiff elastic body 2 against the rigid-sphere scene
+    st, rg = runs["stiff_two_body"], runs["stiff_rigid"]
+    win = (0.005, _curve(rg, "h")[-1])
+    dF = _rel_on(rg, st, "F", _curve(rg, "h"), _curve(st, "h"), win)
+    da = _rel_on(rg, st, "a", _curve(rg, "h"), _curve(st, "h"), win)
+    fig["stiff"] = {"window_h_over_R": list(win), "F_max_pct": 100 * float(np.abs(dF).max()),
+                    "a_max_pct": 100 * float(np.abs(da).max()),
+                    "h2_over_h_end": float(_curve(st, "h2")[-1] / _curve(st, "h")[-1]),
+                    "wall_two_body_s": st["wall_s"], "wall_rigid_s": rg["wall_s"]}
+    limits = {"equal": 0.5, "hertz": 1.0, "stiff": 1.0}
+    fig["pass"] = {
+        "equal": fig["equal"]["F_max_pct"] <= limits["equal"] and fig["equal"]["a_max_pct"] <= limits["equal"],
+        "hertz": fig["hertz"]["F_vs_a_max_pct"] <= 1.0 and fig["hertz"]["h1_over_h2_dev_pct_small_h"] <= 2.0,
+        "stiff": fig["stiff"]["F_max_pct"] <= 1.0 and fig["stiff"]["a_max_pct"] <= 1.0}
+    fig["quick"] = quick
+    return fig
+
+
+def _plot(runs: dict, outdir: Path) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
+    two, flat = runs["equal_two_body"], runs["equal_flat"]
+    ax[0].plot(_curve(flat, "h"), _curve(flat, "F"), "k-", label="one hemisphere on a flat")
+    ax[0].plot(_curve(two, "h1"), _curve(two, "F"), "r--", label="two hemispheres (h₁)")
+    ax[0].set(xlabel="per-body approach h/R", ylabel="F/(σY R²)", title="equal pair, EPP E/σY = 200")
+    hz = runs["hertz"]
+    ax[1].plot(_curve(hz, "a"), _curve(hz, "h1") / _curve(hz, "h2"), "b.-", label="FE h₁/h₂")
+    ax[1].axhline((600 / 0.96) / (200 / 0.91), color="k", ls=":", label="E'₂/E'₁")
+    ax[1].set(xlabel="a/R₁", ylabel="h₁/h₂", title="elastic E₂/E₁ = 3, R₂/R₁ = 2")
+    st, rg = runs["stiff_two_body"], runs["stiff_rigid"]
+    ax[2].plot(_curve(rg, "h"), _curve(rg, "F"), "k-", label="rigid sphere")
+    ax[2].plot(_curve(st, "h"), _curve(st, "F"), "r--", label="elastic, E₂/E₁ = 1000")
+    ax[2].set(xlabel="h/R", ylabel="F/(σY R²)", title="stiff partner")
+    for a in ax:
+        a.legend()
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    path = outdir / "pair.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path.name
+
+
+def _report(fig: dict, png: str, outdir: Path, wall: float) -> None:
+    e, hz, st = fig["equal"], fig["hertz"], fig["stiff"]
+    ok = {k: "pass" if v else "FAIL" for k, v in fig["pass"].items()}
+    lines = [
+        "# FE verification: two deformable spheres", "",
+        f"`python -m spherecontact.fem.verification_pair{' --quick' if fig['quick'] else ''}`, "
+        f"{wall:.0f} s. Figures in `pair_verification.json`.", "",
+        "| check | figure | limit | result |", "|---|---|---|---|",
+        f"| equal pair as two bodies vs one on a flat, h/R {e['window_h_over_R'][0]:g}–"
+        f"{e['window_h_over_R'][1]:g} | F max {e['F_max_pct']:.2f} % (rms {e['F_rms_pct']:.2f} %), "
+        f"a max {e['a_max_pct']:.2f} % (rms {e['a_rms_pct']:.2f} %); h₁/h₂ − 1 ≤ "
+        f"{e['h1_h2_max_dev_pct']:.1e} % | 0.5 % | {ok['equal']} |",
+        f"| elastic E₂/E₁ = 3, R₂/R₁ = 2, ν 0.3/0.2: F vs a (reference config.) against Hertz "
+        f"with E*, R*, a/R₁ 0.01–0.05 | max {hz['F_vs_a_max_pct']:.2f} %, mean "
+        f"{hz['F_vs_a_mean_pct']:+.2f} % | 1 % | {ok['hertz']} |",
+        f"| same: h₁/h₂ against E'₂/E'₁ = {hz['h1_over_h2_target']:.4f} at a/R₁ ≤ 0.02 | max "
+        f"{hz['h1_over_h2_dev_pct_small_h']:.2f} % (whole run {hz['h1_over_h2_dev_pct_all']:.2f} %) "
+        f"| 2 % | {ok['hertz']} |",
+        f"| EPP body 1 vs elastic body 2 with E₂/E₁ = 1000 against the rigid-sphere scene, "
+        f"h/R {st['window_h_over_R'][0]:g}–{st['window_h_over_R'][1]:g} | F max "
+        f"{st['F_max_pct']:.2f} %, a max {st['a_max_pct']:.2f} %; h₂/h at the end "
+        f"{st['h2_over_h_end']:.1e} | 1 % | {ok['stiff']} |", "",
+        "Wall times (one core each, the other core busy): equal pair two bodies "
+        f"{e['wall_two_body_s']:.0f} s ({e['dofs_two_body']} dofs) vs one on a flat "
+        f"{e['wall_flat_s']:.0f} s ({e['dofs_flat']} dofs); stiff partner two bodies "
+        f"{st['wall_two_body_s']:.0f} s vs rigid sphere {st['wall_rigid_s']:.0f} s.", "",
+        f"![pair checks]({png})", ""]
+    (outdir / "pair.md").write_text("\n".join(lines))
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m spherecontact.fem.verification_pair",
+                                description=__doc__.split("\n\n")[0])
+    p.add_argument("--out", default="reports/fem", help="output directory")
+    p.add_argument("--quick", action="store_true", help="coarse meshes and short runs (~1 min)")
+    p.add_argument("--reuse", action="store_true", help="reuse DIR/pair_<case>.json runs")
+    p.add_argument("--workers", type=int, default=2, help="parallel runs (default 2)")
+    args = p.parse_args(argv)
+    outdir = Path(args.out)
+    outdir.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    cases = _cases(args.quick)
+    runs = {}
+    if args.reuse:
+        for name in cases:
+            path = outdir / f"pair_{name}.json"
+            if path.exists():
+                runs[name] = json.loads(path.read_text())
+    todo = [n for n in cases if n not in runs]
+    with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
+        futures = {pool.submit(_run, n, cases[n], outdir): n for n in todo}
+        for fut in as_completed(futures):
+            runs[futures[fut]] = fut.result()
+            print(f"{futures[fut]}: {runs[futures[fut]]['status']}, {runs[futures[fut]]['wall_s']:.0f} s",
+                  flush=True)
+    fig = evaluate(runs, args.quick)
+    (outdir / "pair_verification.json").write_text(json.dumps(fig, indent=2))
+    _report(fig, _plot(runs, outdir), outdir, time.perf_counter() - t0)
+    print(json.dumps(fig["pass"]))
+    return 0 if all(fig["pass"].values()) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
