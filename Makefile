@@ -9,6 +9,7 @@ export MKL_NUM_THREADS ?= 1
 
 .PHONY: test bench lint verify-fem demo clean
 .PHONY: fem
+.PHONY: validate
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -28,6 +29,10 @@ fem: $(STAMP)
 
 verify-fem: $(STAMP)
 	$(PY) -m spherecontact.fem.verification --out reports/fem
+
+validate: $(STAMP)
+	$(PY) -m spherecontact.validation --db data/reference.h5 --coefficients data/coefficients.json \
+		--thresholds validation/thresholds.toml --out reports/validation
 
 bench: $(STAMP)
 	$(PY) -m bench.run_all

@@ -1,0 +1,78 @@
+"""``python -m spherecontact.validation``: the validation report from the reference database.
+
+    python -m spherecontact.validation --db data/reference.h5 \\
+        --coefficients data/coefficients.json --thresholds validation/thresholds.toml \\
+        --out reports/validation
+
+Writes ``OUT/index.md`` and its PNG charts. Exit status: 0 when every validation run is
+within the thresholds, 1 when some run exceeds them (the runs are named on stderr),
+2 on bad input (missing database, no validation run, unreadable thresholds or
+coefficients).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m spherecontact.validation",
+                                description=__doc__.splitlines()[0])
+    p.add_argument("--db", default="data/reference.h5", help="reference database (HDF5)")
+    p.add_argument("--coefficients", default=None,
+                   help="model coefficient file (default: the model's default, data/coefficients.json)")
+    p.add_argument("--thresholds", default="validation/thresholds.toml", help="thresholds (TOML)")
+    p.add_argument("--out", default="reports/validation", help="output directory")
+    p.add_argument("--set", default="validation", help="database set to validate on")
+    p.add_argument("--studies-set", default="studies", help="database set of the FE studies")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    t0 = time.perf_counter()
+    from ..model import load_coefficients
+    from .cases import load_cases, load_records
+    from .config import load_thresholds
+    from .report import build_report
+
+    db = Path(args.db)
+    try:
+        if not db.is_file():
+            raise FileNotFoundError(f"database {db} not found")
+        th = load_thresholds(args.thresholds)
+        coeffs = load_coefficients(args.coefficients) if args.coefficients else load_coefficients()
+        validation = load_cases(db, args.set)
+        if not validation:
+            raise ValueError(f"{db}: no run in the set {args.set!r}")
+        studies = load_cases(db, args.studies_set)
+        try:
+            calibration = load_records(db, "calibration")
+        except (KeyError, ValueError):
+            calibration = []
+        records = load_records(db, args.set)
+    except (OSError, ValueError) as err:
+        print(f"validation: {err}", file=sys.stderr)
+        return 2
+    compared = {c.key for c in validation}
+    skipped = [f"{r.case or r.key} ({r.status}: {r.reason})" for r in records if r.key not in compared]
+    res = build_report(validation, studies, coeffs, th, args.out, source=str(db),
+                       coeff_path=args.coefficients or "model default", th_path=args.thresholds,
+                       calibration_records=calibration, skipped=skipped)
+    dt = time.perf_counter() - t0
+    print(f"validation: {len(res.comparisons)} runs, report {res.path} ({len(res.pngs)} charts), "
+          f"{dt:.1f} s")
+    if res.failures:
+        print(f"validation: {len(res.failures)} runs exceed the thresholds:", file=sys.stderr)
+        for f in res.failures:
+            print(f"  {f}", file=sys.stderr)
+        return 1
+    print("validation: all runs within the thresholds")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
