@@ -36,6 +36,11 @@ def make_case(name="run", scene="flat", material=PP200, h=None, scale_F=1.0, sca
     if scene == "two_body":
         inputs["radius2"] = radius2
         inputs["material2"] = dict(material2 or material)
+    for k, v in (params or {}).items():  # study variants are real inputs of the run
+        if k in ("mesh_density", "element"):
+            inputs[k] = v
+        elif k in ("strain_increment", "penalty"):
+            inputs["options"][k] = v
     inputs.update(extra_inputs or {})
     c0 = Case("k-" + name, set, name, {"scene": scene, **(params or {})}, inputs, {"h": h})
     s1, s2 = spheres(c0)
@@ -209,7 +214,53 @@ def test_cli_exit_status_names_failing_runs(tmp_path, monkeypatch, capsys):
         assert (out / png).stat().st_size > 1000, png
     assert "does not warn" in text or "warned" in text
     # all runs within the thresholds: exit 0
-    runs["validation"] = runs["validation"][:1]
+    runs["validation"], runs["studies"] = runs["validation"][:1], []
     assert main(["--db", str(db), "--out", str(out)]) == 0
     # no database: exit 2
     assert main(["--db", str(tmp_path / "missing.h5"), "--out", str(out)]) == 2
+
+
+# ============================================================================ through the database
+def _result(case: Case):
+    """A RunResult holding a case's curves (the fixture database stores real run groups)."""
+    from spherecontact.fem.solver import RunResult
+
+    h = case.h
+    n = h.size
+    curves = {k: np.asarray(v, float) for k, v in case.curves.items()}
+    F, a = curves["F"], curves["a"]
+    curves.update(F_support=F.copy(), a_nodes=a.copy(), a_ref=a.copy(), p_m=F / (np.pi * a**2),
+                  eps_p_max=np.linspace(0, 0.3, n), active_changes=np.zeros(n))
+    final = {"X": np.zeros((2, 4)), "u": np.zeros(8), "cells": np.array([[0, 1, 2, 3]]),
+             "eps_p": np.zeros((1, 4))}
+    return RunResult(inputs=case.inputs, curves=curves, residuals=[[1e-3, 1e-9]] * n,
+                     profile_r=np.zeros((n, 3)), profile_p=np.zeros((n, 3)), profile_g=np.zeros((n, 3)),
+                     status="converged", reason="reached h_max",
+                     timings={"wall_s": case.wall_s, "increments": n}, final=final)
+
+
+def _fixture_database(path, cases):
+    from spherecontact.data import Record, append_run, input_key
+
+    for c in cases:
+        key = input_key(c.inputs)
+        rec = Record(key, c.set, c.name, "converged", "reached h_max", c.wall_s, c.inputs, c.params)
+        append_run(path, rec, _result(c))
+
+
+def test_report_from_a_fixture_database(tmp_path, capsys):
+    from spherecontact.validation.__main__ import main
+
+    db = tmp_path / "reference.h5"
+    val = [make_case("flat-E300", material={**PP200, "E": 300.0}, h=np.geomspace(2e-4, 0.3, 25)),
+           make_case("two-R2-Y2", scene="two_body", radius2=2.0, material2={**PP200, "sigma_y": 2.0},
+                     h=np.geomspace(2e-4, 0.3, 25), scale_F=1 / 1.07)]
+    _fixture_database(db, val + _studies()[:3])
+    out = tmp_path / "report"
+    rc = main(["--db", str(db), "--out", str(out), "--coefficients", "data/coefficients.json"])
+    err = capsys.readouterr().err
+    assert rc == 1 and "two-R2-Y2" in err and "flat-E300" not in err
+    text = (out / "index.md").read_text()
+    assert "dissimilar radii" in text and "h₁/h split" in text
+    assert (out / "curves_two_r2_y2.png").stat().st_size > 1000
+    assert (out / "speed_accuracy.png").stat().st_size > 1000

@@ -112,12 +112,19 @@ def material_from_dict(d: dict) -> Material:
                     K=float(d.get("K", 0.0)), n=float(d.get("n", 1.0)))
 
 
+#: the FE run's own scene names (``run.inputs["scene"]``) → scene of this module
+FE_SCENES = {"rigid_flat": "flat", "rigid_sphere": "rigid_sphere", "two_body": "two_body",
+             "equal_pair_symmetry": "two_body"}
+
+
 def scene_of(params: dict, inputs: dict) -> str:
-    """``flat``, ``rigid_sphere`` or ``two_body`` (the campaign's ``scene`` if it names one)."""
+    """``flat``, ``rigid_sphere`` or ``two_body``: the campaign's ``scene``, else the run's."""
     s = params.get("scene")
     if s in SCENES:
         return s
-    if "material2" in inputs or "radius2" in inputs:
+    if inputs.get("scene") in FE_SCENES:
+        return FE_SCENES[inputs["scene"]]
+    if "material2" in inputs and not math.isinf(float(inputs["material2"].get("E", 0.0))):
         return "two_body"
     if math.isfinite(float(inputs.get("indenter_radius", math.inf))):
         return "rigid_sphere"
@@ -132,7 +139,10 @@ def spheres(case: Case) -> tuple[Sphere, Sphere]:
         m2 = case.inputs.get("material2", case.inputs["material"])
         return s1, Sphere(float(case.inputs.get("radius2", s1.radius)), material_from_dict(m2))
     if scene == "rigid_sphere":
-        return s1, Sphere(float(case.inputs["indenter_radius"]), Material.rigid())
+        R2 = case.inputs.get("indenter_radius", math.inf)
+        if not math.isfinite(float(R2)):
+            R2 = case.inputs["radius2"]
+        return s1, Sphere(float(R2), Material.rigid())
     return s1, Sphere(math.inf, Material.rigid())
 
 

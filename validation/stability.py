@@ -73,6 +73,14 @@ def _partner(case: Case, cases: list[Case], th: Thresholds) -> Case | None:
     return min(cands, key=dist)
 
 
+def _count(x) -> str:
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return "—"
+    return f"{v:g}" if math.isfinite(v) else "—"
+
+
 def _status(c: Case) -> str:
     return c.status if c.status == "converged" else f"{c.status}: {c.reason}"
 
@@ -188,7 +196,7 @@ def increment_section(cases: list[Case], ref: Reference | None, th: Thresholds, 
         its = c.curve("iterations")
         rej = c.provenance.get("timings", {}).get("rejected_increments", math.nan)
         rows.append([f"{v.strain_increment:g}", c.label, c.h.size,
-                     int(its.sum()) if its is not None else "—", f"{float(rej):g}",
+                     int(its.sum()) if its is not None else "—", _count(rej),
                      f"{c.wall_s:.0f}", f"{pct(out_q['F'].max, 2)} ({pct(out_q['F'].rms, 2)})",
                      f"{pct(out_q['a'].max, 2)} ({pct(out_q['a'].rms, 2)})",
                      pct(energy_balance(c), 2), _status(c)])
@@ -233,7 +241,7 @@ def extreme_section(cases: list[Case], coeffs: Coefficients | None, th: Threshol
         sF, sa = summarise(eF, beyond, w), summarise(ea, beyond, w)
         eb = energy_balance(c)
         rows.append([c.label, f"{variant(c, th).h_max:g}", f"{hR[-1]:.3g}", _status(c), n,
-                     f"{head.mean():.1f} / {tail.mean():.1f}" if tail.size else "—", f"{float(rej):g}",
+                     f"{head.mean():.1f} / {tail.mean():.1f}" if tail.size else "—", _count(rej),
                      f"{c.wall_s:.0f}", pct(eb, 2), f"{pct(sF.max)} ({pct(sF.rms)})",
                      f"{pct(sa.max)} ({pct(sa.rms)})"])
         ax[0].plot(hR, c.F, "-", color=f"C{i}", lw=2, label=f"FE {c.label}")
