@@ -1,1 +1,13 @@
-"""Calibration of H̄(Λ), c²(Λ) and the large-deformation terms from FE (DESIGN §2)."""
+"""Calibration of H̄(Λ), c²(Λ) and the large-deformation terms from FE (DESIGN §2).
+
+``python -m spherecontact.calibration --db data/reference.h5 --out data/coefficients.json
+--report reports/calibration`` (``make calibrate``); ``calibration/README.md``.
+"""
+
+import os as _os
+
+# The fits are small dense problems (hundreds of rows, ~20 columns): BLAS threads only
+# add overhead and contend with other jobs on the machine. Effective when this package
+# is imported before numpy (the command line); the Makefile sets the same variables.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    _os.environ.setdefault(_var, "1")

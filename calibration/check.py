@@ -1,0 +1,118 @@
+"""Checks of a fitted coefficient set: F(h) continuous and monotone; model error per FE run.
+
+Monotone and continuous F(h) (DESIGN §3; the model inverts h(a)): along a dense grid
+of contact radii a (step ``STEP`` in ln a, 1e-6 R … 0.95 R) the model state must have
+
+* h(a) and F(a) strictly increasing (then F(h) is increasing and a(h) is unique),
+* a positive stiffness dF/dh,
+* no jump: the secant slopes Δln F/Δln a and Δln h/Δln a stay within ``MAX_SLOPE``
+  (a jump of relative size δ between neighbours would show as a slope ≥ δ/STEP).
+
+This is done for every calibration material (equal spheres and on a rigid flat) and
+for a grid of other materials and pairs (``grid_pairs``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import Material, Sphere, contact, contact_from_radius
+from ..model.coefficients import Coefficients
+from .dataset import RunCurve
+
+__all__ = ["STEP", "MAX_SLOPE", "MonotoneCheck", "check_pair", "grid_pairs", "check_all",
+           "RunError", "run_errors"]
+
+STEP = 0.002
+MAX_SLOPE = 6.0
+WALL = Sphere(math.inf, Material.rigid())
+
+
+@dataclass
+class MonotoneCheck:
+    label: str
+    ok: bool
+    min_dlnF: float   # smallest secant slope d ln F/d ln a
+    min_dlnh: float   # smallest secant slope d ln h/d ln a
+    max_slope: float  # largest secant slope of either
+    min_stiffness: float
+
+
+def check_pair(label: str, s1: Sphere, s2: Sphere, coeffs: Coefficients,
+               a_range=(1e-6, 0.95)) -> MonotoneCheck:
+    """Monotonicity and continuity of the model for one pair (module docstring)."""
+    R = min(s1.radius, s2.radius)
+    lna = np.arange(math.log(a_range[0]), math.log(a_range[1]), STEP)
+    st = contact_from_radius(s1, s2, R * np.exp(lna), coeffs=coeffs)
+    h = st.h1 + st.h2
+    dF = np.diff(np.log(st.F)) / STEP
+    dh = np.diff(np.log(h)) / STEP
+    ok = bool(np.all(np.isfinite(st.F)) and np.all(np.isfinite(h)) and dF.min() > 0 and dh.min() > 0
+              and max(dF.max(), dh.max()) < MAX_SLOPE and st.stiffness.min() > 0)
+    return MonotoneCheck(label, ok, float(dF.min()), float(dh.min()), float(max(dF.max(), dh.max())),
+                         float(np.min(st.stiffness / (st.F / h))))
+
+
+def grid_pairs(calibration: list[Material]) -> list[tuple[str, Sphere, Sphere]]:
+    """Pairs to check: every calibration material (rigid flat, equal spheres) and a grid of
+    other materials (E/σY 3…3e4, ν 0.2–0.45, perfectly plastic to strongly hardening)
+    on a rigid flat, against a rigid sphere, and dissimilar pairs."""
+    out = []
+    for m in calibration:
+        lab = f"E/sy={m.E / m.sigma_y:g} nu={m.nu:g} K/sy={m.K / m.sigma_y:g} n={m.n:g}"
+        out.append((lab + " | flat", Sphere(1.0, m), WALL))
+        out.append((lab + " | equal spheres", Sphere(1.0, m), Sphere(1.0, m)))
+    hard = [(0.0, 1.0), (2.0, 0.15), (2.0, 0.5), (10.0, 0.3), (1.0, 1.0)]
+    grid = [Material(E=E, nu=nu, sigma_y=1.0, K=K, n=n)
+            for E in (3.0, 20.0, 150.0, 700.0, 5000.0, 3e4) for nu in (0.2, 0.45) for K, n in hard]
+    for m in grid:
+        lab = f"E/sy={m.E:g} nu={m.nu:g} K/sy={m.K:g} n={m.n:g}"
+        out.append((lab + " | flat", Sphere(1.0, m), WALL))
+        out.append((lab + " | rigid sphere R_i=0.5R", Sphere(1.0, m), Sphere(0.5, Material.rigid())))
+    for i, m in enumerate(grid[::5]):
+        other = grid[(7 * i + 3) % len(grid)]
+        out.append((f"E/sy={m.E:g} vs E/sy={other.E:g} K/sy={other.K:g} | R2=2R1",
+                    Sphere(1.0, m), Sphere(2.0, other)))
+    table = Material.from_table(E=200.0, nu=0.3, eps_p=[0.0, 0.02, 0.1, 0.5],
+                                sigma=[1.0, 1.3, 1.6, 2.0])
+    out.append(("tabulated E/sy=200 | flat", Sphere(1.0, table), WALL))
+    return out
+
+
+def check_all(coeffs: Coefficients, calibration: list[Material]) -> list[MonotoneCheck]:
+    return [check_pair(lab, s1, s2, coeffs) for lab, s1, s2 in grid_pairs(calibration)]
+
+
+@dataclass
+class RunError:
+    """Model against one FE run over its resolved range (a ≥ a_min): relative errors."""
+
+    key: str
+    group: str
+    scene: str
+    h_range: tuple[float, float]
+    F_rms: float
+    F_max: float
+    a_rms: float
+    a_max: float
+    F_err: np.ndarray    # per FE increment in the range
+    a_err: np.ndarray
+    h: np.ndarray
+
+
+def run_errors(curve: RunCurve, coeffs: Coefficients) -> RunError:
+    """F(h) and a(h) of the model (the FE scene: the body on a rigid flat or sphere) at the
+    FE increments with a ≥ a_min, relative to FE."""
+    sel = curve.a_fe >= curve.a_min
+    h = curve.h_fe[sel]
+    partner = WALL if math.isinf(curve.indenter_radius) else Sphere(curve.indenter_radius,
+                                                                    Material.rigid())
+    st = contact(Sphere(curve.radius, curve.material), partner, h, coeffs=coeffs)
+    eF = st.F / curve.F_fe[sel] - 1.0
+    ea = st.a / curve.a_fe[sel] - 1.0
+    r = lambda e: float(np.sqrt(np.mean(e * e)))  # noqa: E731
+    return RunError(curve.key, curve.group, curve.scene, (float(h[0]), float(h[-1])), r(eF),
+                    float(np.abs(eF).max()), r(ea), float(np.abs(ea).max()), eF, ea, h)

@@ -1,0 +1,62 @@
+"""Command line of the calibration stage (thin layer over :func:`pipeline.calibrate`).
+
+Exit codes: 0 done; 2 bad input (missing, unreadable or empty database); 3 no candidate
+form passed the monotonicity check (nothing written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from .forms import CANDIDATES, FORMS
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m spherecontact.calibration",
+        description="Fit H_bar(Lambda), c2(Lambda), the level boundaries, beta and the "
+                    "large-deformation terms to the FE calibration runs; choose the Level II "
+                    "form by leave-one-material-out cross-validation; write the coefficient "
+                    "file and the report.")
+    p.add_argument("--db", default="data/reference.h5", help="reference database (HDF5)")
+    p.add_argument("--out", default="data/coefficients.json", help="coefficient file to write")
+    p.add_argument("--report", default="reports/calibration", metavar="DIR",
+                   help="report directory (index.md + PNG); '' for none")
+    p.add_argument("--forms", default=",".join(CANDIDATES),
+                   help=f"candidate forms, comma-separated (known: {', '.join(FORMS)})")
+    p.add_argument("--include-stopped", action="store_true",
+                   help="also fit the converged part of runs that stopped early")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    forms = tuple(f for f in args.forms.split(",") if f)
+    unknown = [f for f in forms if f not in FORMS]
+    if unknown or not forms:
+        print(f"calibrate: error: unknown form(s) {unknown}; known: {', '.join(FORMS)}",
+              file=sys.stderr)
+        return 2
+    from .pipeline import calibrate
+
+    t0 = time.perf_counter()
+    try:
+        cal = calibrate(args.db, out=args.out, report_dir=args.report or None,
+                        include_stopped=args.include_stopped, candidates=forms)
+    except FileNotFoundError as err:
+        print(f"calibrate: error: reference database not found: {err.filename or args.db}",
+              file=sys.stderr)
+        return 2
+    except ValueError as err:
+        code = 3 if "monotone" in str(err) else 2
+        print(f"calibrate: error: {err}", file=sys.stderr)
+        return code
+    s = cal.best.summary()
+    print(f"calibrate: {len(cal.dataset.curves)} runs, {cal.dataset.size} points; form "
+          f"'{cal.chosen}'; RMS H_bar {100 * s['H_bar']['rms']:.2f} % (max {100 * s['H_bar']['max']:.2f} %), "
+          f"RMS c2 {100 * s['c2']['rms']:.2f} % (max {100 * s['c2']['max']:.2f} %); "
+          f"{time.perf_counter() - t0:.1f} s")
+    print(f"calibrate: wrote {args.out}" + (f" and {args.report}/index.md" if args.report else ""))
+    return 0

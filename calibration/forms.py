@@ -1,0 +1,208 @@
+"""Candidate functional forms: a parameter vector ↔ a schema-2 coefficient set.
+
+Every candidate is a restriction of the model's coefficient schema
+(``model/README.md``), so whatever is fitted is evaluated by the model's own code
+(:func:`predict` calls ``spherecontact.model.single.BodyLaw``) and can be written to
+``data/coefficients.json`` as it is.
+
+Free parameters of a form (bounds in :func:`Form.parameters`):
+
+* β (ε_rep = β a/ρ), ln Λ_I and ln(Λ_III/Λ_I);
+* Level III: H̄_III(n) = P exp(Σ g_k n^(k+1)), c²_III(n) likewise (``n_III`` terms each);
+* Level II shape terms b_k (``n_shape``), straight (seed), polynomial or smooth (C¹ Hermite);
+* finite-size factor 1 + Σ f_k x^(k+1) on H̄ and c² (``n_finite``);
+* optional collapse blend (``collapse``): ln H̄_c prefactor, exponent, x-polynomial,
+  ln c²_c prefactor, x-polynomial, ln of the sharpness k.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import levels
+from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients
+from ..model.single import BodyLaw, effective_exponent
+from .dataset import Dataset
+
+__all__ = ["Form", "FORMS", "CANDIDATES", "predict", "predict_exact", "hertz_start"]
+
+
+@dataclass(frozen=True)
+class Form:
+    """A candidate functional form (see module docstring)."""
+
+    name: str
+    description: str
+    smooth: bool = False        # Level II: cubic Hermite (C¹) instead of polynomial in t
+    n_shape_H: int = 0          # Level II shape terms of H̄
+    n_shape_c: int = 0          # ... of c²
+    n_III_H: int = 1            # exp_poly terms of H̄_III(n)
+    n_III_c: int = 1            # ... of c²_III(n)
+    n_finite_H: int = 1         # finite-size polynomial terms of H̄
+    n_finite_c: int = 1         # ... of c²
+    collapse: bool = True       # large-deformation collapse blend
+    n_collapse_H: int = 1       # x_poly terms of H̄_c
+    n_collapse_c: int = 2       # x_poly terms of c²_c
+    n_collapse_nH: int = 1      # exp_poly (hardening) terms of H̄_c
+    ratio: str = "a_over_R"     # finite-size ratio
+    eps_lo: float = 0.01        # secant of the effective hardening exponent
+    eps_hi: float = 0.1
+
+    # ------------------------------------------------------------------ parameters
+    def parameters(self) -> list[tuple[str, float, float, float]]:
+        """(name, start, lower bound, upper bound) of every free parameter, in order."""
+        p = [("beta", 0.32, 0.05, 1.0),
+             ("ln_Lambda_I", math.log(3.0), math.log(1.0), math.log(10.0)),
+             ("ln_Lambda_III_over_I", math.log(30.0), math.log(2.0), math.log(3000.0)),
+             ("H_III", 2.9, 1.5, 4.5)]
+        p += [(f"H_III_n{k}", 0.0, -5.0, 5.0) for k in range(self.n_III_H)]
+        p += [("c2_III", 1.35, 0.6, 2.5)]
+        p += [(f"c2_III_n{k}", -0.9, -5.0, 5.0) if k == 0 else (f"c2_III_n{k}", 0.0, -5.0, 5.0)
+              for k in range(self.n_III_c)]
+        p += [(f"H_shape{k}", 0.0, -8.0, 8.0) for k in range(self.n_shape_H)]
+        p += [(f"c2_shape{k}", 0.0, -8.0, 8.0) for k in range(self.n_shape_c)]
+        p += [(f"fs_H{k}", 0.3 if k == 0 else 0.0, -5.0, 5.0) for k in range(self.n_finite_H)]
+        p += [(f"fs_c2{k}", 0.1 if k == 0 else 0.0, -5.0, 5.0) for k in range(self.n_finite_c)]
+        if self.collapse:
+            p += [("ln_Hc", math.log(1.2), math.log(0.2), math.log(10.0)),
+                  ("Hc_exponent", 0.8, 0.05, 3.0)]
+            p += [(f"Hc_x{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_H)]
+            p += [(f"Hc_n{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_nH)]
+            p += [("ln_c2c", math.log(0.9), math.log(0.2), math.log(4.0))]
+            p += [(f"c2c_x{k}", 0.0, -6.0, 6.0) for k in range(self.n_collapse_c)]
+            p += [("ln_sharpness", math.log(2.0), math.log(0.5), math.log(30.0))]
+        return p
+
+    @property
+    def names(self) -> list[str]:
+        return [q[0] for q in self.parameters()]
+
+    def start(self) -> np.ndarray:
+        return np.array([q[1] for q in self.parameters()])
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        ps = self.parameters()
+        return np.array([q[2] for q in ps]), np.array([q[3] for q in ps])
+
+    # ------------------------------------------------------------------ coefficient set
+    def to_dict(self, params) -> dict:
+        """Schema-2 coefficient dictionary of a parameter vector (source 'calibration')."""
+        v = dict(zip(self.names, (float(x) for x in params), strict=True))
+        seq = lambda prefix, n: [v[f"{prefix}{k}"] for k in range(n)]  # noqa: E731
+        lam1 = math.exp(v["ln_Lambda_I"])
+        d = {
+            "schema_version": SCHEMA_VERSION,
+            "source": "calibration",
+            "provenance": {},
+            "beta": v["beta"],
+            "Lambda_I": lam1,
+            "Lambda_III": lam1 * math.exp(v["ln_Lambda_III_over_I"]),
+            "H_bar_III": {"prefactor": v["H_III"], "exp_poly": seq("H_III_n", self.n_III_H)},
+            "c2_III": {"prefactor": v["c2_III"], "exp_poly": seq("c2_III_n", self.n_III_c)},
+            "level_II": {"H_bar_shape": seq("H_shape", self.n_shape_H),
+                         "c2_shape": seq("c2_shape", self.n_shape_c), "smooth": self.smooth},
+            "hardening_exponent": {"method": "secant_loglog", "eps_lo": self.eps_lo,
+                                   "eps_hi": self.eps_hi},
+            "finite_size": {"ratio": self.ratio, "H_bar": seq("fs_H", self.n_finite_H),
+                            "c2": seq("fs_c2", self.n_finite_c)},
+            "collapse": None,
+            "references": {},
+        }
+        if self.collapse:
+            d["collapse"] = {
+                "H_bar": {"prefactor": math.exp(v["ln_Hc"]), "exponent": v["Hc_exponent"],
+                          "x_poly": seq("Hc_x", self.n_collapse_H),
+                          "exp_poly": seq("Hc_n", self.n_collapse_nH)},
+                "c2": {"prefactor": math.exp(v["ln_c2c"]), "exponent": 0.0,
+                       "x_poly": seq("c2c_x", self.n_collapse_c), "exp_poly": []},
+                "sharpness": math.exp(v["ln_sharpness"]),
+            }
+        return d
+
+    def coefficients(self, params) -> Coefficients:
+        return Coefficients.from_dict(self.to_dict(params))
+
+    @property
+    def n_params(self) -> int:
+        return len(self.parameters())
+
+
+def predict_exact(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
+    """Model p_m and c² at the points of ``ds``: the model's single-body law run by run."""
+    p = np.empty(ds.size)
+    c = np.empty(ds.size)
+    ratio_R = coeffs.finite_size_ratio == "a_over_R"
+    for i, curve in enumerate(ds.curves):
+        m = ds.run == i
+        law = BodyLaw(curve.material, coeffs)
+        r = law.response(ds.x_rho[m], ds.x_R[m] if ratio_R else ds.x_rho[m])
+        p[m] = r.p_m
+        c[m] = r.c2
+    return p, c
+
+
+def _per_point(ds: Dataset, values) -> np.ndarray:
+    return np.asarray(values, dtype=float)[ds.run]
+
+
+def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
+    """Model p_m and c² at the points of ``ds``, all runs in one vectorised pass.
+
+    The same equations as :func:`predict_exact` (the model's ``BodyLaw.response``),
+    written with the model's level functions over all points at once: the fits
+    evaluate it thousands of times. Agreement is tested to rounding.
+    """
+    mats = [c.material for c in ds.curves]
+    n_eff = _per_point(ds, [0.0 if math.isinf(m.sigma_y) else effective_exponent(m, coeffs)
+                            for m in mats])
+    eps = coeffs.beta * ds.x_rho
+    if any(m.is_tabulated for m in mats):
+        sig = np.empty(ds.size)
+        for i, m in enumerate(mats):
+            sel = ds.run == i
+            sig[sel] = m.flow_stress(eps[sel])
+    else:
+        sy = _per_point(ds, [m.sigma_y for m in mats])
+        K = _per_point(ds, [m.K for m in mats])
+        n = _per_point(ds, [m.n for m in mats])
+        sig = sy + K * eps**n
+    elastic = ~np.isfinite(sig)
+    Lam = np.where(elastic, 0.0, ds.E_prime * ds.x_rho / np.where(elastic, 1.0, sig))
+    y = ds.x_R if coeffs.finite_size_ratio == "a_over_R" else ds.x_rho
+    H, _ = levels.H_bar_and_slope(Lam, coeffs, n_eff)
+    c, _ = levels.c2_and_slope(Lam, coeffs, n_eff)
+    H = H * levels.finite_size_factor(y, coeffs.finite_size_H_bar)[0]
+    c = c * levels.finite_size_factor(y, coeffs.finite_size_c2)[0]
+    b = levels.collapse_blend(H, c, y, coeffs, n_eff)
+    # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor (H̄ = 0 there)
+    hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
+        y, coeffs.finite_size_H_bar)[0]
+    p = np.where(elastic, hertz, b.H_bar * np.where(elastic, 1.0, sig))
+    return p, b.c2
+
+
+def hertz_start() -> Coefficients:
+    """The literature set (schema 1): the reference the calibration starts from."""
+    return Coefficients.from_dict(LITERATURE)
+
+
+#: The candidate forms, by name. ``seed``: Level II straight in ln Λ (seed §2);
+#: ``poly``: polynomial Level II shape; ``smooth``: C¹ Hermite Level II with one shape
+#: term. All share the Level III, finite-size and collapse terms, so the CV comparison
+#: isolates the Level II form; ``no_collapse`` and ``a_over_rho`` test the
+#: large-deformation choices.
+FORMS: dict[str, Form] = {
+    "seed": Form("seed", "Level II straight in ln Λ (seed §2); kinks at Λ_I and Λ_III"),
+    "poly": Form("poly", "Level II cubic in t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) (2 shape terms each); "
+                 "kinks at Λ_I and Λ_III", n_shape_H=2, n_shape_c=2),
+    "smooth": Form("smooth", "Level II C¹ Hermite (Hertz slope at Λ_I, flat at Λ_III) + "
+                   "1 shape term each; H̄, c², dF/dh continuous", smooth=True, n_shape_H=1,
+                   n_shape_c=1),
+    "smooth2": Form("smooth2", "as smooth, 2 shape terms each", smooth=True, n_shape_H=2,
+                    n_shape_c=2),
+}
+#: forms compared by cross-validation in every calibration
+CANDIDATES = ("seed", "poly", "smooth", "smooth2")

@@ -1,0 +1,253 @@
+"""The calibration stage end to end: database → fits → choice → checks → coefficient file.
+
+:func:`calibrate_runs` works on ``(key, run)`` pairs (tests use synthetic runs);
+:func:`calibrate` opens the reference database through its reader API
+(``spherecontact.data.Database``) and writes ``data/coefficients.json``.
+
+Choice of the form, by the numbers: every candidate of ``forms.CANDIDATES`` is fitted
+and cross-validated (leave one material out); the chosen form has the smallest
+pooled CV error E_cv = sqrt((RMS_H̄² + RMS_c²²)/2) among the forms whose coefficient
+set passes the monotonicity/continuity check (``check``); a form with fewer parameters
+is preferred when its E_cv is within ``PARSIMONY`` (relative) of the smallest. The large-deformation
+options (ratio a/R or a/ρ, collapse blend or not) are compared on the full set with
+the chosen Level II form.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..model.coefficients import Coefficients
+from .check import MonotoneCheck, RunError, check_all, run_errors
+from .crossval import CVResult, cross_validate
+from .dataset import Dataset, build_dataset
+from .fit import FitResult, fit, rms, round_sig
+from .forms import CANDIDATES, FORMS, Form
+
+__all__ = ["Calibration", "calibrate_runs", "calibrate", "load_runs", "coefficient_file",
+           "write_json", "cv_score"]
+
+#: relative E_cv margin within which the form with fewer parameters is preferred
+PARSIMONY = 0.02
+
+METHOD = ("scipy.optimize.least_squares (trf, bounds) of ln(p_m) and ln(c2), model/FE, on FE "
+          "curves resampled uniformly in ln h; form chosen by leave-one-material-out "
+          "cross-validation")
+
+REFERENCES = {
+    "beta": "Fitted to the FE calibration set (Ludwik hardening runs); Tabor (1951) 0.2, "
+            "Biwa & Storakers (1995) 0.32 for comparison.",
+    "Lambda_I": "Fitted; Level I is exact Hertz (Hertz 1882; Johnson 1985 sec. 4.2).",
+    "Lambda_III": "Fitted; fully plastic regime (Johnson 1985 sec. 6.5; Mesarovic & Fleck 1999).",
+    "H_bar_III": "Fitted; cf. Biwa & Storakers (1995) 3.07 with beta = 0.32.",
+    "c2_III": "Fitted; form of Storakers, Biwa & Larsson (1997) Int. J. Solids Struct. 34:3061.",
+    "level_II": "Fitted shape; seed sec. 2 (straight in ln Lambda) compared by cross-validation.",
+    "finite_size": "Fitted: finite sphere (far field cut off at ~R) and large deformation, "
+                   "vanishing as a/R -> 0 (DESIGN sec. 2).",
+    "collapse": "Fitted: at large a/R the plastic zone reaches the free surface and the sphere "
+                "flattens as a whole; smooth minimum of the half-space and whole-body hardness "
+                "(model/README.md).",
+}
+
+
+def cv_score(cv: CVResult) -> float:
+    """E_cv = sqrt((RMS_H̄² + RMS_c²²)/2) of the pooled held-out errors."""
+    p = cv.pooled()
+    return math.sqrt(0.5 * (p["H_bar"]["rms"] ** 2 + p["c2"]["rms"] ** 2))
+
+
+@dataclass
+class Calibration:
+    """Everything a calibration produced (inputs to the coefficient file and the report)."""
+
+    dataset: Dataset
+    fits: dict[str, FitResult]
+    cv: dict[str, CVResult]
+    chosen: str
+    checks: list[MonotoneCheck]
+    run_errors: list[RunError]
+    alternatives: dict[str, FitResult] = field(default_factory=dict)  # large-deformation options
+    alternative_checks: dict[str, bool] = field(default_factory=dict)
+    source: dict = field(default_factory=dict)   # database path, hash, date, run keys, excluded
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def best(self) -> FitResult:
+        return self.fits[self.chosen]
+
+
+def _variant(form: Form, **changes) -> Form:
+    return dataclasses.replace(form, **changes)
+
+
+def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
+                   large_deformation_options: bool = True, source: dict | None = None) -> Calibration:
+    """Fit, cross-validate, choose, check. ``runs``: iterable of ``(key, run)``."""
+    t0 = time.perf_counter()
+    ds = build_dataset(runs)
+    timings = {"dataset_s": time.perf_counter() - t0}
+    t = time.perf_counter()
+    fits = {name: fit(ds, FORMS[name]) for name in candidates}
+    timings["fits_s"] = time.perf_counter() - t
+    t = time.perf_counter()
+    cv = {name: cross_validate(ds, fits[name]) for name in candidates} \
+        if cross_validation and len(ds.groups) >= 2 else {}
+    timings["cross_validation_s"] = time.perf_counter() - t
+    t = time.perf_counter()
+    mats = []
+    for c in ds.curves:
+        if c.material not in mats:
+            mats.append(c.material)
+    checks_ok: dict[str, bool] = {}
+    checks: dict[str, list[MonotoneCheck]] = {}
+
+    def passes(name: str) -> bool:
+        if name not in checks:
+            checks[name] = check_all(fits[name].coeffs, mats)
+            checks_ok[name] = all(c.ok for c in checks[name])
+        return checks_ok[name]
+
+    def score(name: str) -> float:
+        if name in cv:
+            return cv_score(cv[name])
+        e = fits[name].errors
+        return math.sqrt(0.5 * (rms(e["H_bar"]) ** 2 + rms(e["c2"]) ** 2))
+
+    order = sorted(candidates, key=lambda n: (score(n), FORMS[n].n_params, n))
+    ok = [n for n in order if passes(n)]
+    chosen = None
+    if ok:
+        limit = score(ok[0]) * (1.0 + PARSIMONY)
+        chosen = min((n for n in ok if score(n) <= limit), key=lambda n: (FORMS[n].n_params, score(n), n))
+    if chosen is None:
+        raise ValueError("no candidate form gives a monotone and continuous F(h): "
+                         + "; ".join(f"{n}: {[c.label for c in checks[n] if not c.ok][:3]}"
+                                     for n in order))
+    timings["checks_s"] = time.perf_counter() - t
+    alternatives, alt_ok = {}, {}
+    if large_deformation_options:
+        t = time.perf_counter()
+        base = fits[chosen]
+        for label, form in (
+                ("ratio a/rho", _variant(base.form, name=base.form.name + "_a_over_rho",
+                                         ratio="a_over_rho")),
+                ("no collapse", _variant(base.form, name=base.form.name + "_no_collapse",
+                                         collapse=False))):
+            alternatives[label] = fit(ds, form)
+            alt_ok[label] = all(c.ok for c in check_all(alternatives[label].coeffs, mats))
+        timings["alternatives_s"] = time.perf_counter() - t
+    errs = [run_errors(c, fits[chosen].coeffs) for c in ds.curves]
+    timings["total_s"] = time.perf_counter() - t0
+    return Calibration(dataset=ds, fits=fits, cv=cv, chosen=chosen, checks=checks[chosen],
+                       run_errors=errs, alternatives=alternatives, alternative_checks=alt_ok,
+                       source=dict(source or {}), timings=timings)
+
+
+def load_runs(db_path, include_stopped: bool = False):
+    """Calibration runs of the database: ``(runs, source)``.
+
+    ``runs`` are ``(key, run)`` pairs of set "calibration" (converged; also stopped ones
+    with ``include_stopped``); ``source`` describes the database: path, content hash,
+    the date of the newest run used (the coefficient file's date, so the same database
+    gives the same file), the keys used and those left out with their status.
+    Raises FileNotFoundError/ValueError (from the reader) for a missing or unreadable
+    file and ValueError if it holds no usable calibration run.
+    """
+    from spherecontact.data import Database
+
+    db = Database(db_path)
+    pairs = db.runs(set="calibration", status="converged")
+    if include_stopped:
+        pairs += db.runs(set="calibration", status="stopped")
+        pairs.sort(key=lambda p: (p[0].case, p[0].key))
+    if not pairs:
+        n_all = len(db.records(set="calibration"))
+        raise ValueError(f"{db_path}: no converged calibration runs ({n_all} calibration entries, "
+                         f"{len(db)} entries in all)")
+    used = {r.key for r, _ in pairs}
+    left_out = [{"key": r.key, "case": r.case, "status": r.status, "reason": r.reason}
+                for r in db.records(set="calibration") if r.key not in used]
+    dates = sorted(str(run.provenance.get("date_utc", "")) for _, run in pairs)
+    source = {"path": str(db_path), "content_hash": db.content_hash, "date": dates[-1][:10] or None,
+              "runs": [{"key": r.key, "case": r.case} for r, _ in pairs], "left_out": left_out}
+    return [(f"{r.case} [{r.key}]", run) for r, run in pairs], source
+
+
+def _stats(e) -> dict:
+    e = np.asarray(e, dtype=float)
+    return {"rms": round_sig(rms(e), 4), "max": round_sig(float(np.max(np.abs(e))), 4)}
+
+
+def coefficient_file(cal: Calibration) -> dict:
+    """The schema-2 dictionary written to ``data/coefficients.json``."""
+    best = cal.best
+    d = json.loads(json.dumps(best.coeff_dict))
+    ds = cal.dataset
+    d["provenance"] = {
+        "created": cal.source.get("date"),
+        "created_from": "date of the newest FE run used (not the wall clock): the same database "
+                        "gives the same file",
+        "method": METHOD,
+        "form": {"name": best.form.name, "description": best.form.description,
+                 "n_params": best.form.n_params},
+        "fe_dataset": {
+            "path": cal.source.get("path"),
+            "content_hash": cal.source.get("content_hash"),
+            "set": "calibration",
+            "runs": len(ds.curves),
+            "materials": len(ds.groups),
+            "points": ds.size,
+            "filter": f"a >= {ds.curves[0].a_min / ds.curves[0].radius:g} R at mesh density 1 "
+                      "(20/3 pole elements)",
+        },
+        "fit_residuals": {q: _stats(e) for q, e in best.errors.items()},
+        "cross_validation": {n: {q: {k: round_sig(v, 4) for k, v in s.items()}
+                                 for q, s in cv.pooled().items()} | {"score": round_sig(cv_score(cv), 4)}
+                             for n, cv in cal.cv.items()},
+        "model_error_per_run": {e.key: {"F": {"rms": round_sig(e.F_rms, 4), "max": round_sig(e.F_max, 4)},
+                                        "a": {"rms": round_sig(e.a_rms, 4), "max": round_sig(e.a_max, 4)}}
+                                for e in cal.run_errors},
+        "monotone_check": {"pairs": len(cal.checks), "passed": sum(c.ok for c in cal.checks)},
+        "notes": "Residuals are relative (model/FE - 1) over the calibration points; "
+                 "see reports/calibration/index.md.",
+    }
+    d["references"] = dict(REFERENCES)
+    Coefficients.from_dict(d)  # validate before writing
+    return d
+
+
+def write_json(path, d: dict) -> Path:
+    """Write ``d`` as JSON (sorted layout fixed by insertion order, 2-space indent, final newline)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = json.dumps(d, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(path)
+    return path
+
+
+def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = False,
+              candidates=CANDIDATES) -> Calibration:
+    """Calibrate from the database at ``db_path``; write the coefficient file and the report."""
+    t0 = time.perf_counter()
+    runs, source = load_runs(db_path, include_stopped)
+    read_s = time.perf_counter() - t0
+    cal = calibrate_runs(runs, candidates=candidates, source=source)
+    cal.timings["read_s"] = read_s
+    if out is not None:
+        write_json(out, coefficient_file(cal))
+    if report_dir is not None:
+        from .report import write_report
+
+        t = time.perf_counter()
+        write_report(cal, report_dir)
+        cal.timings["report_s"] = time.perf_counter() - t
+    return cal

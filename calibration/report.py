@@ -1,0 +1,328 @@
+"""Calibration report: ``index.md`` and PNG charts (matplotlib, Agg).
+
+Charts: ``hbar_c2_lambda.png`` (H̄ and c² against Λ, every FE point coloured by
+material and hardening, the fitted model at the same points as lines, the half-space
+master curves a/R → 0 dashed), ``hbar_c2_aR.png`` (the same against a/R: the
+large-deformation range), ``residuals.png`` (relative residuals against Λ and a/R),
+``model_error.png`` (model F(h) and a(h) against every FE run).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..model import levels
+from ..model.single import effective_exponent
+from .dataset import quantities
+from .fit import rms
+from .forms import predict
+from .pipeline import Calibration, cv_score
+
+__all__ = ["write_report"]
+
+def _style(cal: Calibration) -> dict:
+    """Colour per material (tab20, materials sorted by label)."""
+    import matplotlib.pyplot as plt
+
+    cmap = plt.get_cmap("tab20")
+    return {g: cmap(i % 20) for i, g in enumerate(cal.dataset.groups)}
+
+
+def _marker(curve) -> str:
+    """Marker per scene: o rigid flat (equal spheres), ^ rigid sphere."""
+    return "o" if curve.scene == "flat" else "^"
+
+
+def _plots(cal: Calibration, out: Path) -> list[str]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ds, best = cal.dataset, cal.best
+    co = best.coeffs
+    q = quantities(ds, co.beta)
+    p_mod, c_mod = predict(ds, co)
+    H_mod = p_mod / q["sigma_rep"]
+    colours = _style(cal)
+    names = []
+
+    # ---------------------------------------------------------------- H̄, c² vs Λ
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5.8))
+    for i, c in enumerate(ds.curves):
+        m = ds.run == i
+        col = colours[c.group]
+        lab = c.group + ("" if c.scene == "flat" else " (rigid sphere)")
+        axes[0].plot(q["Lambda"][m], q["H_bar"][m], _marker(c), ms=3.5, color=col, label=lab)
+        axes[0].plot(q["Lambda"][m], H_mod[m], "-", lw=1.0, color=col)
+        axes[1].plot(q["Lambda"][m], ds.c2[m], _marker(c), ms=3.5, color=col)
+        axes[1].plot(q["Lambda"][m], c_mod[m], "-", lw=1.0, color=col)
+    L = np.geomspace(0.5, max(2e3, float(np.nanmax(q["Lambda"])) * 1.2), 400)
+    ns = sorted({round(effective_exponent(c.material, co), 4) for c in ds.curves})
+    for n in ns:
+        Hh, _ = levels.H_bar_and_slope(L, co, n)
+        ch, _ = levels.c2_and_slope(L, co, n)
+        axes[0].plot(L, Hh, "k--", lw=0.8, alpha=0.6)
+        axes[1].plot(L, ch, "k--", lw=0.8, alpha=0.6)
+    for ax in axes:
+        ax.set_xscale("log")
+        ax.set_xlabel("Λ = E′a/(σ_rep ρ)")
+        for lam in (co.Lambda_I, co.Lambda_III):
+            ax.axvline(lam, color="grey", lw=0.6, ls=":")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("H̄ = p_m/σ_rep")
+    axes[1].set_ylabel("c² = a²/(2hρ)")
+    axes[0].set_title(f"H̄ vs Λ — points: FE, lines: model ({best.form.name}); dashed: a/R → 0")
+    axes[1].set_title("c² vs Λ (dotted: Λ_I, Λ_III)")
+    axes[0].legend(fontsize=6.5, ncol=2, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(out / "hbar_c2_lambda.png", dpi=110)
+    plt.close(fig)
+    names.append("hbar_c2_lambda.png")
+
+    # ---------------------------------------------------------------- vs a/R
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5.5))
+    for i, c in enumerate(ds.curves):
+        m = ds.run == i
+        col = colours[c.group]
+        axes[0].plot(ds.x_R[m], q["H_bar"][m], _marker(c), ms=3.5, color=col, label=c.group)
+        axes[0].plot(ds.x_R[m], H_mod[m], "-", lw=1.0, color=col)
+        axes[1].plot(ds.x_R[m], ds.c2[m], _marker(c), ms=3.5, color=col)
+        axes[1].plot(ds.x_R[m], c_mod[m], "-", lw=1.0, color=col)
+    for ax in axes:
+        ax.set_xlabel("a/R")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("H̄")
+    axes[1].set_ylabel("c²")
+    axes[0].set_title("H̄ vs a/R (large deformation); o flat, ^ rigid sphere")
+    axes[1].set_title("c² vs a/R")
+    fig.tight_layout()
+    fig.savefig(out / "hbar_c2_aR.png", dpi=110)
+    plt.close(fig)
+    names.append("hbar_c2_aR.png")
+
+    # ---------------------------------------------------------------- residuals
+    fig, axes = plt.subplots(2, 2, figsize=(13, 8), sharey="row")
+    e = best.errors
+    for i, c in enumerate(ds.curves):
+        m = ds.run == i
+        col = colours[c.group]
+        for row, qn in enumerate(("H_bar", "c2")):
+            axes[row, 0].plot(q["Lambda"][m], 100 * e[qn][m], _marker(c), ms=3, color=col)
+            axes[row, 1].plot(ds.x_R[m], 100 * e[qn][m], _marker(c), ms=3, color=col)
+    for row, qn in enumerate(("H̄", "c²")):
+        axes[row, 0].set_xscale("log")
+        axes[row, 0].set_ylabel(f"{qn}: model/FE − 1 [%]")
+        for ax in axes[row]:
+            ax.axhline(0, color="k", lw=0.6)
+            for v in (-2, 2):
+                ax.axhline(v, color="grey", lw=0.6, ls="--")
+            ax.grid(alpha=0.3)
+    axes[1, 0].set_xlabel("Λ")
+    axes[1, 1].set_xlabel("a/R")
+    axes[0, 0].set_title("residuals vs Λ (dashed: ±2 %)")
+    axes[0, 1].set_title("residuals vs a/R")
+    fig.tight_layout()
+    fig.savefig(out / "residuals.png", dpi=110)
+    plt.close(fig)
+    names.append("residuals.png")
+
+    # ---------------------------------------------------------------- model F(h), a(h) errors
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5))
+    for r, c in zip(cal.run_errors, ds.curves, strict=True):
+        col = colours[c.group]
+        ls = "-" if c.scene == "flat" else "--"
+        axes[0].plot(r.h / c.radius, 100 * r.F_err, ls, lw=1.0, color=col, label=c.group)
+        axes[1].plot(r.h / c.radius, 100 * r.a_err, ls, lw=1.0, color=col)
+    for ax, t in zip(axes, ("F(h): model/FE − 1 [%]", "a(h): model/FE − 1 [%]"), strict=True):
+        ax.set_xscale("log")
+        ax.set_xlabel("h/R (approach of the body)")
+        ax.set_ylabel(t)
+        ax.axhline(0, color="k", lw=0.6)
+        ax.grid(alpha=0.3)
+    axes[0].set_title("model against every calibration run (— flat, -- rigid sphere)")
+    fig.tight_layout()
+    fig.savefig(out / "model_error.png", dpi=110)
+    plt.close(fig)
+    names.append("model_error.png")
+    return names
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:.2f} %"
+
+
+def _fmt(v) -> str:
+    if isinstance(v, list):
+        return "[" + ", ".join(_fmt(x) for x in v) + "]" if v else "—"
+    if isinstance(v, float):
+        return f"{v:.5g}"
+    return str(v)
+
+
+def _markdown(cal: Calibration, charts: list[str]) -> str:
+    ds, best = cal.dataset, cal.best
+    co = best.coeff_dict
+    src = cal.source
+    L = []
+    L.append("# Calibration of the unified contact model\n")
+    L.append("Generated by `make calibrate` (`python -m spherecontact.calibration`). Symbols of "
+             "DESIGN.md §2; the coefficient schema is in `model/README.md`.\n")
+    L.append("## Data\n")
+    L.append(f"* database: `{src.get('path', '—')}`, content hash `{src.get('content_hash', '—')}`, "
+             f"newest run {src.get('date', '—')}")
+    L.append(f"* {len(ds.curves)} calibration runs, {len(ds.groups)} materials, {ds.size} points "
+             f"(each run resampled on a fixed grid of {16} points per decade of h; local linear "
+             "fit in ln–ln over ±1 grid step, which averages the force staircase of the surface mesh)")
+    a_min = ds.curves[0].a_min / ds.curves[0].radius
+    L.append(f"* resolution filter a ≥ {a_min:g} R (20/3 pole elements of the default mesh): in the "
+             "elastic verification run the sub-element contact radius reproduces Hertz's p_m and c² "
+             "to within 0.5 % from a = 0.02 R on and is off by 1–5 % below it")
+    if src.get("left_out"):
+        L.append("* left out (not converged): " + ", ".join(f"{x['case']} ({x['status']})"
+                                                         for x in src["left_out"]))
+    L.append("")
+    L.append("| run | scene | points | a/R range | Λ range (fitted β) |")
+    L.append("|---|---|---|---|---|")
+    q = quantities(ds, best.coeffs.beta)
+    for i, c in enumerate(ds.curves):
+        m = ds.run == i
+        L.append(f"| {c.key} | {c.scene} | {int(m.sum())} | {ds.x_R[m].min():.3f}–{ds.x_R[m].max():.3f} "
+                 f"| {q['Lambda'][m].min():.3g}–{q['Lambda'][m].max():.3g} |")
+    L.append("")
+
+    L.append("## Choice of the Level II form: leave-one-material-out cross-validation\n")
+    L.append("Each fold holds out every run of one material (both scenes), refits on the rest "
+             "(warm start from the full fit, at most 8 iterations) and predicts the held-out "
+             "points. Score E_cv = √((RMS_H̄² + RMS_c²²)/2) over all held-out points; the form "
+             "with the smallest E_cv whose F(h) passes the monotonicity check is chosen.\n")
+    L.append("| form | parameters | fit RMS H̄ | fit RMS c² | CV RMS H̄ | CV max H̄ | CV RMS c² | CV max c² "
+             "| E_cv | worst fold (c²) | monotone |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|---|")
+    for name, f in cal.fits.items():
+        s = f.summary()
+        row = [f"**{name}**" if name == cal.chosen else name, str(f.form.n_params),
+               _pct(s["H_bar"]["rms"]), _pct(s["c2"]["rms"])]
+        if name in cal.cv:
+            cv = cal.cv[name]
+            p = cv.pooled()
+            g, v = cv.worst_fold("c2")
+            row += [_pct(p["H_bar"]["rms"]), _pct(p["H_bar"]["max"]), _pct(p["c2"]["rms"]),
+                    _pct(p["c2"]["max"]), _pct(cv_score(cv)), f"{g}: {_pct(v)}"]
+        else:
+            row += ["—"] * 6
+        row.append("yes" if name == cal.chosen or name not in cal.cv else "—")
+        L.append("| " + " | ".join(row) + " |")
+    L.append("")
+    for name, f in cal.fits.items():
+        L.append(f"* `{name}`: {f.form.description}"
+                 + (f"; parameters at a bound: {', '.join(f.at_bounds)}" if f.at_bounds else ""))
+    L.append(f"\nChosen: **{cal.chosen}**.\n")
+
+    if cal.alternatives:
+        L.append("## Large-deformation terms: which ratio, and is the collapse blend needed?\n")
+        L.append("Same Level II form, full calibration set; the rigid-sphere runs (ρ = R/2) "
+                 "separate a/R from a/ρ.\n")
+        L.append("| variant | RMS H̄ | max H̄ | RMS c² | max c² | RMS H̄ rigid-sphere runs | "
+                 "RMS c² rigid-sphere runs | monotone |")
+        L.append("|---|---|---|---|---|---|---|---|")
+        sphere = np.array([c.scene != "flat" for c in ds.curves])[ds.run]
+        rows = [("chosen (a/R, collapse)", best, True)] + [
+            (k, v, cal.alternative_checks.get(k, False)) for k, v in cal.alternatives.items()]
+        for lab, f, ok in rows:
+            s = f.summary()
+            rs = [_pct(rms(f.errors[qq][sphere])) if sphere.any() else "—" for qq in ("H_bar", "c2")]
+            L.append(f"| {lab} | {_pct(s['H_bar']['rms'])} | {_pct(s['H_bar']['max'])} | "
+                     f"{_pct(s['c2']['rms'])} | {_pct(s['c2']['max'])} | {rs[0]} | {rs[1]} | "
+                     f"{'yes' if ok else 'NO'} |")
+        L.append("")
+
+    L.append("## Fitted coefficients\n")
+    L.append("| key | value |")
+    L.append("|---|---|")
+    L.append(f"| β | {_fmt(co['beta'])} |")
+    L.append(f"| Λ_I, Λ_III | {_fmt(co['Lambda_I'])}, {_fmt(co['Lambda_III'])} |")
+    H3, c3, l2 = co["H_bar_III"], co["c2_III"], co["level_II"]
+    L.append(f"| H̄_III(n) | {_fmt(H3['prefactor'])} · exp(Σ {_fmt(H3['exp_poly'])} n^k) |")
+    L.append(f"| c²_III(n) | {_fmt(c3['prefactor'])} · exp(Σ {_fmt(c3['exp_poly'])} n^k) |")
+    L.append(f"| Level II | smooth = {l2['smooth']}, H̄ shape {_fmt(l2['H_bar_shape'])}, "
+             f"c² shape {_fmt(l2['c2_shape'])} |")
+    fs = co["finite_size"]
+    L.append(f"| finite size ({fs['ratio']}) | H̄ {_fmt(fs['H_bar'])}, c² {_fmt(fs['c2'])} |")
+    if co.get("collapse"):
+        col = co["collapse"]
+        L.append(f"| collapse H̄_c | {_fmt(col['H_bar']['prefactor'])} x^−{_fmt(col['H_bar']['exponent'])} "
+                 f"exp(Σ {_fmt(col['H_bar']['x_poly'])} x^k + Σ {_fmt(col['H_bar']['exp_poly'])} n^k) |")
+        L.append(f"| collapse c²_c | {_fmt(col['c2']['prefactor'])} exp(Σ {_fmt(col['c2']['x_poly'])} x^k) |")
+        L.append(f"| sharpness k | {_fmt(col['sharpness'])} |")
+    he = co["hardening_exponent"]
+    L.append(f"| effective exponent n | secant of ln σ_f vs ln ε_p between {he['eps_lo']:g} "
+             f"and {he['eps_hi']:g} |")
+    L.append("")
+
+    L.append("## Residuals of the chosen form (relative, model/FE − 1)\n")
+    L.append("| quantity | RMS | max | target |")
+    L.append("|---|---|---|---|")
+    for qn, lab in (("H_bar", "H̄"), ("c2", "c²")):
+        e = best.errors[qn]
+        L.append(f"| {lab} | {_pct(rms(e))} | {_pct(float(np.max(np.abs(e))))} | 2 % RMS "
+                 f"({'met' if rms(e) <= 0.02 else 'NOT met'}) |")
+    L.append("")
+    L.append("| run | RMS H̄ | max H̄ | RMS c² | max c² |")
+    L.append("|---|---|---|---|---|")
+    for i, c in enumerate(ds.curves):
+        m = ds.run == i
+        eH, ec = best.errors["H_bar"][m], best.errors["c2"][m]
+        L.append(f"| {c.key} | {_pct(rms(eH))} | {_pct(np.abs(eH).max())} | {_pct(rms(ec))} | "
+                 f"{_pct(np.abs(ec).max())} |")
+    L.append("")
+
+    L.append("## Model error in F(h) and a(h) per calibration run\n")
+    L.append("The model (`spherecontact.model.contact`, the FE scene: the sphere on a rigid flat "
+             "or rigid sphere) at every FE increment with a ≥ a_min, relative to FE.\n")
+    L.append("| run | h/R range | RMS F | max F | RMS a | max a |")
+    L.append("|---|---|---|---|---|---|")
+    for r in cal.run_errors:
+        L.append(f"| {r.key} | {r.h_range[0]:.2g}–{r.h_range[1]:.2g} | {_pct(r.F_rms)} | {_pct(r.F_max)} | "
+                 f"{_pct(r.a_rms)} | {_pct(r.a_max)} |")
+    allF = np.concatenate([r.F_err for r in cal.run_errors])
+    alla = np.concatenate([r.a_err for r in cal.run_errors])
+    L.append(f"| **all** | | {_pct(rms(allF))} | {_pct(np.abs(allF).max())} | {_pct(rms(alla))} | "
+             f"{_pct(np.abs(alla).max())} |")
+    L.append("")
+
+    L.append("## Continuity and monotonicity of F(h)\n")
+    bad = [c for c in cal.checks if not c.ok]
+    L.append(f"{len(cal.checks)} pairs (every calibration material as equal spheres and on a rigid "
+             "flat; a grid of E/σY 3–3·10⁴, ν 0.2/0.45, perfectly plastic to K/σY = 10, on a flat and "
+             "against a rigid sphere; dissimilar pairs; a tabulated flow curve), contact radius "
+             f"1e-6 R … 0.95 R in steps of 0.2 % : {len(cal.checks) - len(bad)} pass "
+             "(h(a), F(a) strictly increasing, stiffness > 0, no jump).")
+    mins = min(c.min_dlnF for c in cal.checks), min(c.min_dlnh for c in cal.checks)
+    L.append(f"Smallest secant slopes over all pairs: d ln F/d ln a = {mins[0]:.3f}, "
+             f"d ln h/d ln a = {mins[1]:.3f}; largest {max(c.max_slope for c in cal.checks):.3f}.")
+    for c in bad:
+        L.append(f"* FAILED: {c.label} (dlnF {c.min_dlnF:.3g}, dlnh {c.min_dlnh:.3g}, "
+                 f"max slope {c.max_slope:.3g})")
+    L.append("")
+
+    L.append("## Charts\n")
+    for n in charts:
+        L.append(f"![{n}]({n})\n")
+    if cal.timings:
+        L.append("## Timing\n")
+        L.append(", ".join(f"{k} {v:.1f} s" for k, v in cal.timings.items()) + "\n")
+    return "\n".join(L)
+
+
+def write_report(cal: Calibration, out) -> Path:
+    """Write ``index.md`` and the charts into the directory ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    charts = _plots(cal, out)
+    p = out / "index.md"
+    p.write_text(_markdown(cal, charts), encoding="utf-8")
+    return p
+
