@@ -264,3 +264,27 @@ def test_report_from_a_fixture_database(tmp_path, capsys):
     assert "dissimilar radii" in text and "h₁/h split" in text
     assert (out / "curves_two_r2_y2.png").stat().st_size > 1000
     assert (out / "speed_accuracy.png").stat().st_size > 1000
+
+
+@pytest.mark.slow
+def test_report_from_tiny_fe_runs(tmp_path):
+    """Real coarse FE runs (flat and a dissimilar pair) through the database and the CLI."""
+    from spherecontact.data import Record, append_run, input_key
+    from spherecontact.fem.io import run_indentation
+    from spherecontact.validation.__main__ import main
+
+    m = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    db = tmp_path / "reference.h5"
+    for name, kw in (("flat", {"density": 0.5}),
+                     ("two-R2-Y2", {"density": 0.25, "radius2": 2.0,
+                                    "material2": Material(E=200.0, nu=0.3, sigma_y=2.0)})):
+        res = run_indentation(m, 1.0, 0.02, **kw)
+        rec = Record(input_key(res.inputs), "validation", name, res.status, res.reason,
+                     res.timings["wall_s"], res.inputs, {})
+        append_run(db, rec, res)
+    out = tmp_path / "report"
+    rc = main(["--db", str(db), "--out", str(out)])
+    assert rc in (0, 1)
+    text = (out / "index.md").read_text()
+    assert "flat" in text and "two-R2-Y2" in text and "dissimilar radii" in text
+    assert (out / "curves_two_r2_y2.png").stat().st_size > 1000

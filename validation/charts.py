@@ -113,10 +113,13 @@ def curves_chart(comp: Comparison, th: Thresholds, out: Path) -> Path:
         ax[0, 2].set_ylim(0, 1)
         ax[0, 2].set_ylabel("h₁ / h")
         ax[0, 2].legend(fontsize=7)
+        worst = 10.0
         for q, style in (("h1", "C0-"), ("h2", "C9-")):
             if q in comp.model.errors:
-                ax[1, 2].plot(hR, 100 * comp.model.errors[q], style, label=f"model {q}")
-        ax[1, 2].set_ylim(-30, 30)
+                e = 100 * comp.model.errors[q]
+                ax[1, 2].plot(hR, e, style, label=f"model {q}")
+                worst = max(worst, 1.15 * np.nanmax(np.abs(e[comp.masks[W_ACCEPT]]), initial=0.0))
+        ax[1, 2].set_ylim(-min(worst, 100.0), min(worst, 100.0))
         ax[1, 2].set_ylabel("relative error %")
         ax[1, 2].set_xlabel("h / R")
         ax[1, 2].legend(fontsize=7)
