@@ -120,16 +120,20 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
         e = fits[name].errors
         return math.sqrt(0.5 * (rms(e["H_bar"]) ** 2 + rms(e["c2"]) ** 2))
 
-    order = sorted(candidates, key=lambda n: (score(n), FORMS[n].n_params, n))
-    ok = [n for n in order if passes(n)]
+    remaining = sorted(candidates, key=lambda n: (score(n), FORMS[n].n_params, n))
     chosen = None
-    if ok:
-        limit = score(ok[0]) * (1.0 + PARSIMONY)
-        chosen = min((n for n in ok if score(n) <= limit), key=lambda n: (FORMS[n].n_params, score(n), n))
+    while remaining and chosen is None:
+        limit = score(remaining[0]) * (1.0 + PARSIMONY)
+        pick = min((n for n in remaining if score(n) <= limit),
+                   key=lambda n: (FORMS[n].n_params, score(n), n))
+        if passes(pick):
+            chosen = pick
+        else:
+            remaining.remove(pick)
     if chosen is None:
         raise ValueError("no candidate form gives a monotone and continuous F(h): "
                          + "; ".join(f"{n}: {[c.label for c in checks[n] if not c.ok][:3]}"
-                                     for n in order))
+                                     for n in checks))
     timings["checks_s"] = time.perf_counter() - t
     alternatives, alt_ok = {}, {}
     if large_deformation_options:
