@@ -160,7 +160,7 @@ def test_help_describes_every_option(argv, capsys):
     text = capsys.readouterr().out
     for opt in RUN_OPTIONS:
         assert opt in text, opt
-    for rng in ("(-1, 0.5)", "(0, 0.8 R]", "[0.25, 4]", "[2, 200]", "unit of --radius"):
+    for rng in ("(-1, 0.5)", "(0, 0.8 min(R, R2)]", "[0.25, 4]", "[2, 200]", "unit of --radius"):
         assert rng in text, rng
 
 

@@ -1,0 +1,118 @@
+"""Two deformable spheres: gap derivatives, scene choice, bad pairs, Hertz with E*, R*."""
+
+import math
+
+import numpy as np
+import pytest
+
+from spherecontact.fem.io import choose_scene, read_run, run_indentation, write_run
+from spherecontact.fem.segments import gap_gradient, gap_hessian
+from spherecontact.model.material import Material
+
+STEEL = Material(E=200.0, nu=0.3, sigma_y=1.0, K=0.0, n=1.0)
+
+
+def _arc_pairs(n=6, seed=0):
+    """Slave points near a unit circle (centre (0, −1)) and four control points on it."""
+    rng = np.random.default_rng(seed)
+    th = np.array([0.05, 0.1, 0.15, 0.2])
+    P = np.stack([np.sin(th), np.cos(th) - 1.0])
+    C = np.zeros((10, n))
+    for k in range(4):
+        C[2 + 2 * k:4 + 2 * k] = P[:, k:k + 1]
+    C[0] = rng.uniform(0.1, 0.15, n)
+    C[1] = np.cos(C[0]) - 1.0 + rng.uniform(-1e-2, 1e-2, n)
+    return C
+
+
+def test_gap_is_the_distance_to_a_circle_master():
+    C = _arc_pairs()
+    gap, _, t, normal = gap_gradient(C, side=1.0)
+    exact = np.hypot(C[0], C[1] + 1.0) - 1.0
+    assert np.all((t > 0) & (t < 1))
+    np.testing.assert_allclose(gap, exact, atol=3e-7)  # Catmull–Rom vs the true arc
+    np.testing.assert_allclose(np.hypot(*normal), 1.0, rtol=1e-14)
+
+
+def test_gap_gradient_and_hessian_match_finite_differences():
+    C = _arc_pairs()
+    gap, grad, _, _ = gap_gradient(C, 1.0)
+    H = gap_hessian(C, 1.0)
+    eps = 1e-6
+    for j in range(10):
+        Cp, Cm = C.copy(), C.copy()
+        Cp[j] += eps
+        Cm[j] -= eps
+        fd = (gap_gradient(Cp, 1.0)[0] - gap_gradient(Cm, 1.0)[0]) / (2 * eps)
+        np.testing.assert_allclose(grad[j], fd, atol=1e-8)
+        fdh = (gap_gradient(Cp, 1.0)[1] - gap_gradient(Cm, 1.0)[1]) / (2 * eps)
+        np.testing.assert_allclose(H[:, j], fdh, atol=1e-6)
+    np.testing.assert_allclose(H, H.transpose(1, 0, 2), atol=1e-12)
+
+
+@pytest.mark.parametrize("kw, scene", [
+    ({}, "rigid_flat"),
+    ({"indenter_radius": 2.0}, "rigid_sphere"),
+    ({"radius2": 2.0, "material2": Material.rigid()}, "rigid_sphere"),
+    ({"radius2": math.inf, "material2": Material.rigid()}, "rigid_flat"),
+    ({"radius2": 1.0, "material2": STEEL}, "equal_pair_symmetry"),
+    ({"radius2": 2.0, "material2": STEEL}, "two_body"),
+    ({"radius2": 1.0, "material2": Material(E=600.0, nu=0.3, sigma_y=1.0, K=0.0, n=1.0)}, "two_body"),
+    ({"radius2": 1.0, "material2": STEEL, "scene": "two_body"}, "two_body"),
+])
+def test_cheapest_exact_scene(kw, scene):
+    m2 = kw.get("material2")
+    assert choose_scene(STEEL, 1.0, m2, kw.get("radius2"), kw.get("indenter_radius", math.inf),
+                        kw.get("scene", "auto")) == scene
+
+
+@pytest.mark.parametrize("kw, words", [
+    ({"radius2": -0.5}, "overlap"),
+    ({"radius2": -3.0}, "concave"),
+    ({"material": Material.rigid(), "material2": Material.rigid()}, "both bodies are rigid"),
+    ({"radius": math.inf, "radius2": math.inf}, "two flats"),
+    ({"radius2": math.inf}, "deformable flat"),
+    ({"radius2": 2.0, "indenter_radius": 2.0}, "not both"),
+    ({"radius2": 0.5, "h_max": 0.45}, r"0.8 min\(radius, radius2\)"),
+    ({"scene": "two_body", "material2": Material.rigid()}, "deformable body 2"),
+])
+def test_bad_pairs_are_named_before_any_work(kw, words):
+    args = {"material": STEEL, "radius": 1.0, "h_max": 0.1, **kw}
+    with pytest.raises(ValueError, match=words):
+        run_indentation(**args)
+
+
+def test_elastic_dissimilar_pair_is_hertz_with_effective_modulus_and_radius(tmp_path):
+    m1, m2 = Material.elastic(200.0, 0.3), Material.elastic(600.0, 0.2)
+    res = run_indentation(m1, 1.0, 0.003, radius2=2.0, material2=m2, density=0.5)
+    assert res.status == "converged" and res.inputs["scene"] == "two_body"
+    c = res.curves
+    Es = 1.0 / (1.0 / m1.E_prime + 1.0 / m2.E_prime)
+    Rs = 2.0 / 3.0
+    sel = c["a_ref"] >= 0.025  # three pole elements of the coarse mesh
+    ratio = c["F"][sel] / (4 * Es * c["a_ref"][sel] ** 3 / (3 * Rs))
+    assert np.abs(ratio - 1).max() < 0.025
+    np.testing.assert_allclose(c["h1"] + c["h2"], c["h"], rtol=1e-10)
+    target = m2.E_prime / m1.E_prime
+    assert np.abs(c["h1"][sel] / c["h2"][sel] / target - 1).max() < 0.03
+    # the interface bends towards the softer body 1: curvature between −1/R2 and +1/R1
+    assert np.all((c["interface_curvature"][sel] < 1.0) & (c["interface_curvature"][sel] > -0.5))
+    # Newton stays quadratic through the sliding interface: few iterations per increment
+    assert c["iterations"].mean() < 5
+    path = write_run(tmp_path / "pair.h5", res)
+    run = read_run(path)
+    assert run.scene == "two_body" and run.material2() == m2
+    np.testing.assert_array_equal(run.h1, c["h1"])
+    assert run.mesh["cells"].shape[0] == res.inputs["n_elements"]
+
+
+def test_equal_pair_as_two_bodies_matches_the_symmetric_scene():
+    two = run_indentation(STEEL, 1.0, 0.008, radius2=1.0, material2=STEEL, scene="two_body")
+    sym = run_indentation(STEEL, 1.0, 0.008, radius2=1.0, material2=STEEL)
+    assert sym.inputs["scene"] == "equal_pair_symmetry"
+    np.testing.assert_allclose(two.curves["h1"], two.curves["h2"], rtol=2e-3)
+    np.testing.assert_allclose(sym.curves["h1"], sym.curves["h"] / 2)
+    h = two.h[two.h > 0.003]
+    dF = np.interp(h, two.h, two.F) / np.interp(h, sym.h, sym.F) - 1
+    # node-to-surface contact of two meshes is noisier than the symmetric scene
+    assert np.sqrt(np.mean(dF**2)) < 0.01 and np.abs(dF).max() < 0.025
