@@ -8,10 +8,10 @@ frame (z → −z); the mirror enters only the contact terms.
 
 Contact is frictionless node-to-surface (``segments.py``): the surface nodes
 of the slave body (the smaller sphere; body 1 on a tie) against the C¹
-(Catmull–Rom) curve through the master's surface nodes, with one Lagrange multiplier per active slave node and the
-consistent second derivative of the gap, so Newton stays quadratic through
-large sliding of the interface. No penalty number. Each iteration solves the
-saddle-point system
+(Catmull–Rom) curve through the master's surface nodes, with one Lagrange
+multiplier per active slave node and the consistent second derivative of the
+gap, so Newton stays quadratic through large sliding of the interface. No
+penalty number. Each iteration solves the saddle-point system
 
     [ K − Σ λ_i ∂²g_i    −Gᵀ ] [ Δu ]   = − [ f_int ]
     [ −G                  0  ] [ λ  ]       [ −g    ]

@@ -120,10 +120,11 @@ def evaluate(runs: dict, quick: bool) -> dict:
                     "h2_over_h_end": float(_curve(st, "h2")[-1] / _curve(st, "h")[-1]),
                     "wall_two_body_s": st["wall_s"], "wall_rigid_s": rg["wall_s"]}
     limits = {"equal": 0.5, "hertz": 1.0, "stiff": 1.0}
+    e, hz, st = fig["equal"], fig["hertz"], fig["stiff"]
     fig["pass"] = {
-        "equal": fig["equal"]["F_max_pct"] <= limits["equal"] and fig["equal"]["a_max_pct"] <= limits["equal"],
-        "hertz": fig["hertz"]["F_vs_a_max_pct"] <= 1.0 and fig["hertz"]["h1_over_h2_dev_pct_small_h"] <= 2.0,
-        "stiff": fig["stiff"]["F_max_pct"] <= 1.0 and fig["stiff"]["a_max_pct"] <= 1.0}
+        "equal": max(e["F_max_pct"], e["a_max_pct"]) <= limits["equal"],
+        "hertz": hz["F_vs_a_max_pct"] <= limits["hertz"] and hz["h1_over_h2_dev_pct_small_h"] <= 2.0,
+        "stiff": max(st["F_max_pct"], st["a_max_pct"]) <= limits["stiff"]}
     fig["quick"] = quick
     return fig
 
