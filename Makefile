@@ -7,7 +7,7 @@ export OMP_NUM_THREADS ?= 1
 export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
-.PHONY: test bench lint verify-fem demo clean
+.PHONY: test bench lint verify-fem verify-pair demo clean
 .PHONY: fem
 .PHONY: validate
 
@@ -29,6 +29,9 @@ fem: $(STAMP)
 
 verify-fem: $(STAMP)
 	$(PY) -m spherecontact.fem.verification --out reports/fem
+
+verify-pair: $(STAMP)
+	$(PY) -m spherecontact.fem.verification_pair --out reports/fem
 
 validate: $(STAMP)
 	$(PY) -m spherecontact.validation --db data/reference.h5 --coefficients data/coefficients.json \
