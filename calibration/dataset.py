@@ -181,6 +181,7 @@ class Dataset:
     x_R: np.ndarray    # a/R
     x_rho: np.ndarray  # a/ρ
     h_R: np.ndarray    # h/R
+    cache: dict = field(default_factory=dict, repr=False, compare=False)  # derived per-point arrays
 
     @property
     def size(self) -> int:

@@ -27,6 +27,9 @@ from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients
 from ..model.single import BodyLaw, effective_exponent
 from .dataset import Dataset
 
+#: collapse c²_c is parametrised by its value and slopes at this a/R
+X_C2 = 0.5
+
 __all__ = ["Form", "FORMS", "CANDIDATES", "predict", "predict_exact", "hertz_start"]
 
 
@@ -45,7 +48,7 @@ class Form:
     n_finite_c: int = 1         # ... of c²
     collapse: bool = True       # large-deformation collapse blend
     n_collapse_H: int = 1       # x_poly terms of H̄_c
-    n_collapse_c: int = 2       # x_poly terms of c²_c
+    n_collapse_c: int = 1       # x_poly terms of c²_c
     n_collapse_nH: int = 1      # exp_poly (hardening) terms of H̄_c
     ratio: str = "a_over_R"     # finite-size ratio
     eps_lo: float = 0.01        # secant of the effective hardening exponent
@@ -64,13 +67,15 @@ class Form:
               for k in range(self.n_III_c)]
         p += [(f"H_shape{k}", 0.0, -8.0, 8.0) for k in range(self.n_shape_H)]
         p += [(f"c2_shape{k}", 0.0, -8.0, 8.0) for k in range(self.n_shape_c)]
-        p += [(f"fs_H{k}", 0.3 if k == 0 else 0.0, -5.0, 5.0) for k in range(self.n_finite_H)]
-        p += [(f"fs_c2{k}", 0.1 if k == 0 else 0.0, -5.0, 5.0) for k in range(self.n_finite_c)]
+        # finite-size factors 1 + f x: positive for every x <= 1 (f > -0.9)
+        p += [(f"fs_H{k}", 0.3 if k == 0 else 0.0, -0.9, 3.0) for k in range(self.n_finite_H)]
+        p += [(f"fs_c2{k}", 0.1 if k == 0 else 0.0, -0.9, 3.0) for k in range(self.n_finite_c)]
         if self.collapse:
             p += [("ln_Hc", math.log(1.2), math.log(0.2), math.log(10.0)),
                   ("Hc_exponent", 0.8, 0.05, 3.0)]
             p += [(f"Hc_x{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_H)]
             p += [(f"Hc_n{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_nH)]
+            # c²_c in terms of its value and log slopes at x = X_C2 (well inside the data)
             p += [("ln_c2c", math.log(0.9), math.log(0.2), math.log(4.0))]
             p += [(f"c2c_x{k}", 0.0, -6.0, 6.0) for k in range(self.n_collapse_c)]
             p += [("ln_sharpness", math.log(2.0), math.log(0.5), math.log(30.0))]
@@ -112,12 +117,14 @@ class Form:
             "references": {},
         }
         if self.collapse:
+            # ln c²_c = ln c0 + Σ_k d_k (x − X_C2)^(k+1), expanded in powers of x for the schema
+            shifted = _shift_powers(seq("c2c_x", self.n_collapse_c), X_C2)
             d["collapse"] = {
                 "H_bar": {"prefactor": math.exp(v["ln_Hc"]), "exponent": v["Hc_exponent"],
                           "x_poly": seq("Hc_x", self.n_collapse_H),
                           "exp_poly": seq("Hc_n", self.n_collapse_nH)},
-                "c2": {"prefactor": math.exp(v["ln_c2c"]), "exponent": 0.0,
-                       "x_poly": seq("c2c_x", self.n_collapse_c), "exp_poly": []},
+                "c2": {"prefactor": math.exp(v["ln_c2c"] + shifted[0]), "exponent": 0.0,
+                       "x_poly": [float(c) for c in shifted[1:]], "exp_poly": []},
                 "sharpness": math.exp(v["ln_sharpness"]),
             }
         return d
@@ -128,6 +135,16 @@ class Form:
     @property
     def n_params(self) -> int:
         return len(self.parameters())
+
+
+def _shift_powers(d: list[float], x0: float) -> list[float]:
+    """Coefficients e_j (j = 0..K) with Σ_k d_k (x − x0)^(k+1) = Σ_j e_j x^j (K = len(d))."""
+    e = [0.0] * (len(d) + 1)
+    for k, dk in enumerate(d):
+        p = k + 1
+        for j in range(p + 1):
+            e[j] += dk * math.comb(p, j) * (-x0) ** (p - j)
+    return e
 
 
 def predict_exact(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
@@ -156,8 +173,11 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     evaluate it thousands of times. Agreement is tested to rounding.
     """
     mats = [c.material for c in ds.curves]
-    n_eff = _per_point(ds, [0.0 if math.isinf(m.sigma_y) else effective_exponent(m, coeffs)
-                            for m in mats])
+    key = ("n_eff", coeffs.eps_lo, coeffs.eps_hi)
+    n_eff = ds.cache.get(key)
+    if n_eff is None:
+        n_eff = ds.cache[key] = _per_point(
+            ds, [0.0 if math.isinf(m.sigma_y) else effective_exponent(m, coeffs) for m in mats])
     eps = coeffs.beta * ds.x_rho
     if any(m.is_tabulated for m in mats):
         sig = np.empty(ds.size)
