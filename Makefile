@@ -10,6 +10,7 @@ export MKL_NUM_THREADS ?= 1
 .PHONY: test bench lint verify-fem verify-pair demo clean
 .PHONY: fem
 .PHONY: validate
+.PHONY: calibrate
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -26,6 +27,9 @@ demo: $(STAMP)
 
 fem: $(STAMP)
 	$(PY) -m spherecontact.fem.campaign --campaign data/campaign.toml --db data/reference.h5
+
+calibrate: $(STAMP)
+	$(PY) -m spherecontact.calibration --db data/reference.h5 --out data/coefficients.json --report reports/calibration
 
 verify-fem: $(STAMP)
 	$(PY) -m spherecontact.fem.verification --out reports/fem
