@@ -4,7 +4,9 @@ A fold holds out every run of one material (E/σY, ν, hardening; both scenes, f
 rigid sphere), refits the form on the rest and predicts the held-out points. The fold
 fit starts from the full fit (warm start) and is capped at ``FOLD_NFEV`` iterations:
 dropping one material out of many moves the optimum little, and the cap keeps
-``make calibrate`` fast; the report lists how far each fold's coefficients moved.
+``make calibrate`` fast. Each fold also records how far its coefficient set moved from
+the full fit, as the change of the predicted H̄ and c² over all points (RMS and max):
+the stability of the fit against dropping a material.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 
 from .dataset import Dataset
 from .fit import FitResult, errors, fit, rms
+from .forms import predict
 
 __all__ = ["FOLD_NFEV", "Fold", "CVResult", "cross_validate"]
 
@@ -28,6 +31,8 @@ class Fold:
     n_points: int
     errors: dict[str, np.ndarray]   # held-out relative errors
     params: np.ndarray
+    shift_rms: float = 0.0  # RMS and max change of the predicted H̄, c² over all points
+    shift_max: float = 0.0  # (fold fit against the full fit): stability of the fit
 
 
 @dataclass
@@ -54,8 +59,12 @@ def cross_validate(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV) -> CVRes
     groups = ds.groups
     if len(groups) < 2:
         raise ValueError("cross-validation needs at least two materials")
+    p0, c0 = predict(ds, full.coeffs)
     for g in groups:
         train, test = ds.without_group(g), ds.only_group(g)
         r = fit(train, full.form, start=full.params, max_nfev=nfev)
-        folds.append(Fold(group=g, n_points=test.size, errors=errors(test, r.coeffs), params=r.params))
+        p1, c1 = predict(ds, r.coeffs)
+        shift = np.concatenate([p1 / p0 - 1.0, c1 / c0 - 1.0])
+        folds.append(Fold(group=g, n_points=test.size, errors=errors(test, r.coeffs), params=r.params,
+                          shift_rms=rms(shift), shift_max=float(np.max(np.abs(shift)))))
     return CVResult(form=full.form.name, folds=folds)

@@ -50,7 +50,7 @@ def _plots(cal: Calibration, out: Path) -> list[str]:
     names = []
 
     # ---------------------------------------------------------------- H̄, c² vs Λ
-    fig, axes = plt.subplots(1, 2, figsize=(14, 5.8))
+    fig, axes = plt.subplots(1, 2, figsize=(14, 7.2))
     for i, c in enumerate(ds.curves):
         m = ds.run == i
         col = colours[c.group]
@@ -76,8 +76,9 @@ def _plots(cal: Calibration, out: Path) -> list[str]:
     axes[1].set_ylabel("c² = a²/(2hρ)")
     axes[0].set_title(f"H̄ vs Λ — points: FE, lines: model ({best.form.name}); dashed: a/R → 0")
     axes[1].set_title("c² vs Λ (dotted: Λ_I, Λ_III)")
-    axes[0].legend(fontsize=6.5, ncol=2, loc="upper left")
-    fig.tight_layout()
+    fig.legend(*axes[0].get_legend_handles_labels(), fontsize=7, ncol=4, loc="lower center",
+               bbox_to_anchor=(0.5, 0.0), frameon=False)
+    fig.tight_layout(rect=(0, 0.17, 1, 1))
     fig.savefig(out / "hbar_c2_lambda.png", dpi=110)
     plt.close(fig)
     names.append("hbar_c2_lambda.png")
@@ -220,6 +221,20 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
         L.append(f"* `{name}`: {f.form.description}"
                  + (f"; parameters at a bound: {', '.join(f.at_bounds)}" if f.at_bounds else ""))
     L.append(f"\nChosen: **{cal.chosen}**.\n")
+    if cal.chosen in cal.cv:
+        L.append(f"Folds of the chosen form `{cal.chosen}` and of `seed` (held-out RMS; 'shift': change "
+                 "of the predicted H̄, c² over all points when the material is dropped, RMS/max):\n")
+        L.append("| held-out material | points | RMS H̄ | RMS c² | shift RMS | shift max | seed RMS H̄ "
+                 "| seed RMS c² |")
+        L.append("|---|---|---|---|---|---|---|---|")
+        seed = {f.group: f for f in cal.cv["seed"].folds} if "seed" in cal.cv else {}
+        for f in cal.cv[cal.chosen].folds:
+            sf = seed.get(f.group)
+            sc = [_pct(rms(sf.errors["H_bar"])), _pct(rms(sf.errors["c2"]))] if sf else ["—", "—"]
+            eH, ec = _pct(rms(f.errors["H_bar"])), _pct(rms(f.errors["c2"]))
+            L.append(f"| {f.group} | {f.n_points} | {eH} | {ec} | {_pct(f.shift_rms)} | {_pct(f.shift_max)} "
+                     f"| {sc[0]} | {sc[1]} |")
+        L.append("")
 
     if cal.alternatives:
         L.append("## Large-deformation terms: which ratio, and is the collapse blend needed?\n")
