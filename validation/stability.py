@@ -92,7 +92,7 @@ def locking_section(cases: list[Case], th: Thresholds, out: Path):
     pairs = [(c, p) for c, p in pairs if p is not None]
     if not pairs:
         return "No run with the locking element (`q4`) in the studies set.", None
-    rows = []
+    rows, notes = [], []
     plt = pyplot()
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
     for i, (c, p) in enumerate(pairs):
@@ -100,6 +100,9 @@ def locking_section(cases: list[Case], th: Thresholds, out: Path):
         sa, _ = pair_error(c, p, "a", 0.1)
         spm, _ = pair_error(c, p, "p_m", 0.1)
         m = c.inputs["material"]
+        notes.append(f"`{c.label}` (q4) against `{p.label}` (q8r): final mean pressure "
+                     f"{100 * (_pm(c)[-1] / _pm(p)[-1] - 1):+.0f} %, F up to {pct(sF.max)} % and a up "
+                     f"to {pct(sa.max)} % apart (over h ≥ 0.1 h_end).")
         rows.append([c.label, p.label, f"{m['E'] / m['sigma_y']:g}", f"{variant(c, th).mesh_density:g}",
                      f"{c.h[-1] / reference_radius(c):.3g}", f"{pct(sF.max)} ({pct(sF.rms)})",
                      f"{pct(sa.max)} ({pct(sa.rms)})", f"{pct(spm.max)}",
@@ -123,7 +126,7 @@ def locking_section(cases: list[Case], th: Thresholds, out: Path):
     table = markdown_table(["q4 run", "against q8r run", "E/σ_Y", "mesh density", "h/R end",
                             "F max (rms) %", "a max (rms) %", "p_m max %", "final p_m/σ_Y q4 / q8r",
                             "status"], rows)
-    return table, path
+    return " ".join(notes) + "\n\n" + table, path
 
 
 # ============================================================================ penalty
@@ -135,7 +138,7 @@ def penalty_section(cases: list[Case], th: Thresholds, out: Path):
         return "No penalty-contact run in the studies set.", None
     plt = pyplot()
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
-    rows = []
+    rows, notes = [], []
     for i, c in enumerate(pen):
         p = _partner(c, cases, th)
         v = variant(c, th)
@@ -154,6 +157,8 @@ def penalty_section(cases: list[Case], th: Thresholds, out: Path):
                      f"{int(its.sum()) if its is not None else '—'} / "
                      f"{int(its_p.sum()) if its_p is not None else '—'}",
                      f"{c.wall_s:.0f} / {p.wall_s:.0f}", _status(c)])
+        notes.append(f"penalty {v.penalty:g}: F {pct(sF.max, 2)} %, a {pct(sa.max, 2)} % "
+                     f"({_status(c)})")
         R = reference_radius(p)
         for k, e in enumerate((eF, ea)):
             ax[k].plot(p.h / R, 100 * e, color=f"C{i}", label=f"penalty {v.penalty:g}")
@@ -170,7 +175,9 @@ def penalty_section(cases: list[Case], th: Thresholds, out: Path):
                             "a max (rms) % vs exact", "max penetration / R",
                             "Newton iterations (penalty / exact)", "wall s (penalty / exact)",
                             "status"], rows)
-    return table, path
+    text = ("Largest difference from the exact (active-set) contact over the run: " + "; ".join(notes)
+            + ".") if notes else ""
+    return text + "\n\n" + table, path
 
 
 # ============================================================================ increments
@@ -183,7 +190,7 @@ def increment_section(cases: list[Case], ref: Reference | None, th: Thresholds, 
         return "Fewer than two strain-increment sizes in the studies set.", None
     plt = pyplot()
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
-    rows = []
+    rows, worst = [], []
     R = reference_radius(ref.base)
     for i, c in enumerate(runs):
         v = variant(c, th)
@@ -200,6 +207,7 @@ def increment_section(cases: list[Case], ref: Reference | None, th: Thresholds, 
                      f"{c.wall_s:.0f}", f"{pct(out_q['F'].max, 2)} ({pct(out_q['F'].rms, 2)})",
                      f"{pct(out_q['a'].max, 2)} ({pct(out_q['a'].rms, 2)})",
                      pct(energy_balance(c), 2), _status(c)])
+        worst.append((v.strain_increment, out_q["F"], out_q["a"], energy_balance(c), c))
     for k, q in enumerate(("F", "a")):
         ax[k].set_xlabel("h / R")
         ax[k].set_ylabel(f"{q} relative to best FE estimate %")
@@ -212,7 +220,11 @@ def increment_section(cases: list[Case], ref: Reference | None, th: Thresholds, 
     table = markdown_table(["strain increment Δε", "run", "increments", "Newton iterations",
                             "rejected increments", "wall s", "F max (rms) %", "a max (rms) %",
                             "energy balance miss %", "status"], rows)
-    return table, path
+    de, sF, sa, eb, c = worst[-1]
+    text = (f"The largest increment, Δε = {de:g}: F up to {pct(sF.max, 2)} % and a up to "
+            f"{pct(sa.max, 2)} % from the best estimate, energy balance missed by {pct(eb, 2)} % "
+            f"({_status(c)}); the smallest, Δε = {worst[0][0]:g}: F {pct(worst[0][1].max, 2)} %.")
+    return text + "\n\n" + table, path
 
 
 # ============================================================================ extreme h/R
@@ -223,7 +235,7 @@ def extreme_section(cases: list[Case], coeffs: Coefficients | None, th: Threshol
         return "No run beyond the acceptance window in the studies set.", None
     plt = pyplot()
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
-    rows = []
+    rows, notes = [], []
     for i, c in enumerate(runs):
         R = reference_radius(c)
         hR = c.h / R
@@ -244,6 +256,12 @@ def extreme_section(cases: list[Case], coeffs: Coefficients | None, th: Threshol
                      f"{head.mean():.1f} / {tail.mean():.1f}" if tail.size else "—", _count(rej),
                      f"{c.wall_s:.0f}", pct(eb, 2), f"{pct(sF.max)} ({pct(sF.rms)})",
                      f"{pct(sa.max)} ({pct(sa.rms)})"])
+        notes.append(f"`{c.label}` reached h/R = {hR[-1]:.3g} of {variant(c, th).h_max:g} asked "
+                     f"({_status(c)}) in {n} increments"
+                     + (f", {head.mean():.1f} Newton iterations per increment in the first half and "
+                        f"{tail.mean():.1f} in the last 10 %" if tail.size else "")
+                     + f"; the model is off by up to {pct(sF.max)} % in F beyond h/R = "
+                       f"{th.h_over_R_max:g}.")
         ax[0].plot(hR, c.F, "-", color=f"C{i}", lw=2, label=f"FE {c.label}")
         ax[0].plot(hR, st.F, "--", color=f"C{i}", label="model")
         ax[1].plot(hR, c.a / R, "-", color=f"C{i}", lw=2)
@@ -266,7 +284,7 @@ def extreme_section(cases: list[Case], coeffs: Coefficients | None, th: Threshol
                             "wall s", "energy balance miss %",
                             f"model F max (rms) % beyond {th.h_over_R_max:g}",
                             f"model a max (rms) % beyond {th.h_over_R_max:g}"], rows)
-    return table, path
+    return " ".join(notes) + "\n\n" + table, path
 
 
 # ============================================================================ model outside range
