@@ -16,7 +16,8 @@ measured).
 
 Constraints (penalty rows): H̄ must not decrease with Λ (``monotonicity_penalty``), so
 that the mean pressure rises with 1/ρ and the two-body κ solve has one root (DESIGN §3);
-the collapse limits must keep F and h rising with a up to a = R (``collapse_penalty``).
+the collapse limits must keep F and h rising with a up to a = R (``collapse_penalty``);
+the finite-size factors stay positive up to a = R (``finite_size_penalty``).
 """
 
 from __future__ import annotations
@@ -41,6 +42,8 @@ PENALTY = 30.0
 #: collapse limits: log slopes checked at these a/R, kept this far from the limits ±2
 COLLAPSE_X = np.linspace(0.05, 1.0, 20)
 SLOPE_MARGIN = 0.3
+#: finite-size factors stay above this on 0 ≤ a/R ≤ 1
+FACTOR_MIN = 0.2
 #: significant digits of the written coefficients
 SIGNIFICANT = 6
 #: stopping tolerances (relative change of cost and parameters) and the iteration cap of a
@@ -123,8 +126,15 @@ def collapse_penalty(co: Coefficients) -> np.ndarray:
                                      np.minimum(2.0 - SLOPE_MARGIN - sc, 0.0)])
 
 
+def finite_size_penalty(co: Coefficients) -> np.ndarray:
+    """PENALTY · shortfall of the finite-size factors below ``FACTOR_MIN`` on 0 ≤ x ≤ 1."""
+    fH, _ = levels.finite_size_factor(COLLAPSE_X, co.finite_size_H_bar)
+    fc, _ = levels.finite_size_factor(COLLAPSE_X, co.finite_size_c2)
+    return PENALTY * np.concatenate([np.minimum(fH - FACTOR_MIN, 0.0), np.minimum(fc - FACTOR_MIN, 0.0)])
+
+
 def _residuals(form: Form, ds: Dataset):
-    n_pen = MONOTONE_T.size * MONOTONE_N.size + 2 * COLLAPSE_X.size
+    n_pen = MONOTONE_T.size * MONOTONE_N.size + 4 * COLLAPSE_X.size
     bad = np.full(2 * ds.size + n_pen, 10.0)
 
     def f(params):
@@ -135,7 +145,7 @@ def _residuals(form: Form, ds: Dataset):
         p, c = predict(ds, co)
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.concatenate([np.log(p / ds.p_m), np.log(c / ds.c2), monotonicity_penalty(co),
-                                collapse_penalty(co)])
+                                collapse_penalty(co), finite_size_penalty(co)])
         return np.where(np.isfinite(r), r, 10.0)
 
     return f
