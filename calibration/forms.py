@@ -50,6 +50,7 @@ class Form:
     n_collapse_H: int = 1       # x_poly terms of H̄_c
     n_collapse_c: int = 1       # x_poly terms of c²_c
     n_collapse_nH: int = 1      # exp_poly (hardening) terms of H̄_c
+    n_collapse_nc: int = 1      # ... of c²_c
     ratio: str = "a_over_R"     # finite-size ratio
     eps_lo: float = 0.01        # secant of the effective hardening exponent
     eps_hi: float = 0.1
@@ -78,6 +79,7 @@ class Form:
             # c²_c in terms of its value and log slopes at x = X_C2 (well inside the data)
             p += [("ln_c2c", math.log(0.9), math.log(0.2), math.log(4.0))]
             p += [(f"c2c_x{k}", 0.0, -6.0, 6.0) for k in range(self.n_collapse_c)]
+            p += [(f"c2c_n{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_nc)]
             p += [("ln_sharpness", math.log(2.0), math.log(0.5), math.log(30.0))]
         return p
 
@@ -124,7 +126,8 @@ class Form:
                           "x_poly": seq("Hc_x", self.n_collapse_H),
                           "exp_poly": seq("Hc_n", self.n_collapse_nH)},
                 "c2": {"prefactor": math.exp(v["ln_c2c"] + shifted[0]), "exponent": 0.0,
-                       "x_poly": [float(c) for c in shifted[1:]], "exp_poly": []},
+                       "x_poly": [float(c) for c in shifted[1:]],
+                       "exp_poly": seq("c2c_n", self.n_collapse_nc)},
                 "sharpness": math.exp(v["ln_sharpness"]),
             }
         return d
