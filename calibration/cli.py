@@ -26,8 +26,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="report directory (index.md + PNG); '' for none")
     p.add_argument("--forms", default=",".join(CANDIDATES),
                    help=f"candidate forms, comma-separated (known: {', '.join(FORMS)})")
-    p.add_argument("--include-stopped", action="store_true",
-                   help="also fit the converged part of runs that stopped early")
+    p.add_argument("--converged-only", action="store_true",
+                   help="leave out runs that stopped before h_max (default: fit their converged "
+                        "increments)")
     return p
 
 
@@ -44,7 +45,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     try:
         cal = calibrate(args.db, out=args.out, report_dir=args.report or None,
-                        include_stopped=args.include_stopped, candidates=forms)
+                        include_stopped=not args.converged_only, candidates=forms)
     except FileNotFoundError as err:
         print(f"calibrate: error: reference database not found: {err.filename or args.db}",
               file=sys.stderr)

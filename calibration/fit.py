@@ -119,9 +119,9 @@ def collapse_penalty(co: Coefficients) -> np.ndarray:
     """
     if not co.has_collapse:
         return np.zeros(2 * COLLAPSE_X.size)
-    _, sH = co.collapse_H_bar.log_and_slope(COLLAPSE_X, MONOTONE_N.max())
-    _, sH0 = co.collapse_H_bar.log_and_slope(COLLAPSE_X, 0.0)
-    _, sc = co.collapse_c2.log_and_slope(COLLAPSE_X)
+    _, sH, _ = co.collapse_H_bar.log_and_slope(COLLAPSE_X, MONOTONE_N.max())
+    _, sH0, _ = co.collapse_H_bar.log_and_slope(COLLAPSE_X, 0.0)
+    _, sc, _ = co.collapse_c2.log_and_slope(COLLAPSE_X)
     return PENALTY * np.concatenate([np.minimum(np.minimum(sH, sH0) + 2.0 - SLOPE_MARGIN, 0.0),
                                      np.minimum(2.0 - SLOPE_MARGIN - sc, 0.0)])
 

@@ -51,6 +51,8 @@ class Form:
     n_collapse_c: int = 1       # x_poly terms of c²_c
     n_collapse_nH: int = 1      # exp_poly (hardening) terms of H̄_c
     n_collapse_nc: int = 1      # ... of c²_c
+    n_collapse_zH: int = 0      # z_poly (curvature of the pressing surface) terms of H̄_c
+    n_collapse_zc: int = 1      # ... of c²_c
     ratio: str = "a_over_R"     # finite-size ratio
     eps_lo: float = 0.01        # secant of the effective hardening exponent
     eps_hi: float = 0.1
@@ -80,6 +82,8 @@ class Form:
             p += [("ln_c2c", math.log(0.9), math.log(0.2), math.log(4.0))]
             p += [(f"c2c_x{k}", 0.0, -6.0, 6.0) for k in range(self.n_collapse_c)]
             p += [(f"c2c_n{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_nc)]
+            p += [(f"Hc_z{k}", 0.0, -3.0, 3.0) for k in range(self.n_collapse_zH)]
+            p += [(f"c2c_z{k}", 0.0, -3.0, 3.0) for k in range(self.n_collapse_zc)]
             p += [("ln_sharpness", math.log(2.0), math.log(0.5), math.log(30.0))]
         return p
 
@@ -124,10 +128,12 @@ class Form:
             d["collapse"] = {
                 "H_bar": {"prefactor": math.exp(v["ln_Hc"]), "exponent": v["Hc_exponent"],
                           "x_poly": seq("Hc_x", self.n_collapse_H),
-                          "exp_poly": seq("Hc_n", self.n_collapse_nH)},
+                          "exp_poly": seq("Hc_n", self.n_collapse_nH),
+                          "z_poly": seq("Hc_z", self.n_collapse_zH)},
                 "c2": {"prefactor": math.exp(v["ln_c2c"] + shifted[0]), "exponent": 0.0,
                        "x_poly": [float(c) for c in shifted[1:]],
-                       "exp_poly": seq("c2c_n", self.n_collapse_nc)},
+                       "exp_poly": seq("c2c_n", self.n_collapse_nc),
+                       "z_poly": seq("c2c_z", self.n_collapse_zc)},
                 "sharpness": math.exp(v["ln_sharpness"]),
             }
         return d
@@ -194,12 +200,14 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
         sig = sy + K * eps**n
     elastic = ~np.isfinite(sig)
     Lam = np.where(elastic, 0.0, ds.E_prime * ds.x_rho / np.where(elastic, 1.0, sig))
-    y = ds.x_R if coeffs.finite_size_ratio == "a_over_R" else ds.x_rho
+    ratio_R = coeffs.finite_size_ratio == "a_over_R"
+    y = ds.x_R if ratio_R else ds.x_rho
+    z = ds.x_rho / ds.x_R - 1.0 if ratio_R else 0.0  # R/ρ − 1
     H, _ = levels.H_bar_and_slope(Lam, coeffs, n_eff)
     c, _ = levels.c2_and_slope(Lam, coeffs, n_eff)
     H = H * levels.finite_size_factor(y, coeffs.finite_size_H_bar)[0]
     c = c * levels.finite_size_factor(y, coeffs.finite_size_c2)[0]
-    b = levels.collapse_blend(H, c, y, coeffs, n_eff)
+    b = levels.collapse_blend(H, c, y, coeffs, n_eff, z)
     # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor (H̄ = 0 there)
     hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
         y, coeffs.finite_size_H_bar)[0]

@@ -154,11 +154,13 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
                        source=dict(source or {}), timings=timings)
 
 
-def load_runs(db_path, include_stopped: bool = False):
+def load_runs(db_path, include_stopped: bool = True):
     """Calibration runs of the database: ``(runs, source)``.
 
-    ``runs`` are ``(key, run)`` pairs of set "calibration" (converged; also stopped ones
-    with ``include_stopped``); ``source`` describes the database: path, content hash,
+    ``runs`` are ``(key, run)`` pairs of set "calibration": converged runs and, with
+    ``include_stopped`` (default), the converged increments of runs that stopped early
+    (wall-time limit or increment floor: every stored increment is a converged state,
+    the run just ends before h_max); ``source`` describes the database: path, content hash,
     the date of the newest run used (the coefficient file's date, so the same database
     gives the same file), the keys used and those left out with their status.
     Raises FileNotFoundError/ValueError (from the reader) for a missing or unreadable
@@ -179,8 +181,11 @@ def load_runs(db_path, include_stopped: bool = False):
     left_out = [{"key": r.key, "case": r.case, "status": r.status, "reason": r.reason}
                 for r in db.records(set="calibration") if r.key not in used]
     dates = sorted(str(run.provenance.get("date_utc", "")) for _, run in pairs)
+    partial = [{"key": r.key, "case": r.case, "h_last": float(run.h[-1]), "reason": r.reason}
+               for r, run in pairs if r.status == "stopped"]
     source = {"path": str(db_path), "content_hash": db.content_hash, "date": dates[-1][:10] or None,
-              "runs": [{"key": r.key, "case": r.case} for r, _ in pairs], "left_out": left_out}
+              "runs": [{"key": r.key, "case": r.case} for r, _ in pairs], "left_out": left_out,
+              "partial": partial}
     return [(f"{r.case} [{r.key}]", run) for r, run in pairs], source
 
 
@@ -238,7 +243,7 @@ def write_json(path, d: dict) -> Path:
     return path
 
 
-def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = False,
+def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
               candidates=CANDIDATES) -> Calibration:
     """Calibrate from the database at ``db_path``; write the coefficient file and the report."""
     t0 = time.perf_counter()

@@ -181,8 +181,11 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
     L.append(f"* resolution filter a ≥ {a_min:g} R (20/3 pole elements of the default mesh): in the "
              "elastic verification run the sub-element contact radius reproduces Hertz's p_m and c² "
              "to within 0.5 % from a = 0.02 R on and is off by 1–5 % below it")
+    if src.get("partial"):
+        L.append("* stopped before h_max, their converged increments used: " + ", ".join(
+            f"{x['case']} (to h/R = {x['h_last']:.3g}: {x['reason']})" for x in src["partial"]))
     if src.get("left_out"):
-        L.append("* left out (not converged): " + ", ".join(f"{x['case']} ({x['status']})"
+        L.append("* left out: " + ", ".join(f"{x['case']} ({x['status']})"
                                                          for x in src["left_out"]))
     L.append("")
     L.append("| run | scene | points | a/R range | Λ range (fitted β) |")

@@ -21,7 +21,8 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   which vanishes as x → 0;
 * large-deformation collapse (schema 2, optional; same ratio x): the half-space values
   H̄_hs, c²_hs above are blended with limits of the whole body,
-  L(x, n) = prefactor · x^(−exponent) · exp(Σ_k x_poly[k] x^(k+1) + Σ_k exp_poly[k] n^(k+1)),
+  L(x, n, z) = prefactor · x^(−exponent) · exp(Σ_k x_poly[k] x^(k+1) + Σ_k exp_poly[k] n^(k+1)
+  + Σ_k z_poly[k] z^(k+1)), z = R/ρ − 1 (0 for a flat interface),
   r = H̄_hs/H̄_c,  w = r^k/(1 + r^k)  (k = sharpness),
   H̄ = H̄_hs (1 + r^k)^(−1/k)   (smooth minimum of H̄_hs and H̄_c),
   c² = c²_hs^(1−w) · c²_c^w;  H̄_c → ∞ as x → 0 (exponent > 0), so w → 0 and the
@@ -184,7 +185,8 @@ def _limit(d, where: str) -> CollapseLimit:
         raise ValueError(f"coefficients: '{where}.prefactor' must be > 0, got {pre!r}")
     return CollapseLimit(prefactor=pre, exponent=_number(d, "exponent", where + "."),
                          x_poly=_poly(d, "x_poly", where + "."),
-                         exp_poly=_poly(d, "exp_poly", where + "."))
+                         exp_poly=_poly(d, "exp_poly", where + "."),
+                         z_poly=_poly(d, "z_poly", where + "."))
 
 
 def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
@@ -208,28 +210,42 @@ def _poly_and_slope(x, poly: tuple[float, ...]):
 
 @dataclass(frozen=True)
 class CollapseLimit:
-    """L(x, n) = prefactor · x^(−exponent) · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1))."""
+    """L(x, n, z) = prefactor · x^(−exponent)
+    · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1) + Σ z_poly[k] z^(k+1)).
+
+    x: finite-size ratio, n: effective hardening exponent, z = R/ρ − 1: curvature of the
+    surface pressing the body relative to the body's own (0 for a flat interface, i.e.
+    equal spheres; R/R_i for a rigid sphere of radius R_i).
+    """
 
     prefactor: float
     exponent: float
     x_poly: tuple[float, ...] = ()
     exp_poly: tuple[float, ...] = ()
+    z_poly: tuple[float, ...] = ()
 
-    def log_and_slope(self, x, n=0.0):
-        """ln L(x, n) and d ln L/d ln x, vectorised (x > 0)."""
+    def log_and_slope(self, x, n=0.0, z=0.0):
+        """ln L, d ln L/d ln x and d ln L/d z, vectorised (x > 0)."""
         x = np.asarray(x, dtype=float)
+        z = np.asarray(z, dtype=float)
         s, ds = _poly_and_slope(x, self.x_poly)
+        sz = np.zeros_like(z)  # Σ c_k z^(k+1)
+        dz = np.zeros_like(z)  # Σ (k+1) c_k z^k
+        for k in range(len(self.z_poly) - 1, -1, -1):
+            sz = (sz + self.z_poly[k]) * z
+            dz = dz * z + (k + 1) * self.z_poly[k]
         with np.errstate(divide="ignore"):
-            lnL = (math.log(self.prefactor) - self.exponent * np.log(x) + s
+            lnL = (math.log(self.prefactor) - self.exponent * np.log(x) + s + sz
                    + np.log(_exp_poly(1.0, self.exp_poly, n)))
-        return lnL, ds - self.exponent
+        return lnL, ds - self.exponent, dz
 
-    def __call__(self, x, n=0.0):
-        return np.exp(self.log_and_slope(x, n)[0])
+    def __call__(self, x, n=0.0, z=0.0):
+        return np.exp(self.log_and_slope(x, n, z)[0])
 
     def to_dict(self) -> dict:
         return {"prefactor": self.prefactor, "exponent": self.exponent,
-                "x_poly": list(self.x_poly), "exp_poly": list(self.exp_poly)}
+                "x_poly": list(self.x_poly), "exp_poly": list(self.exp_poly),
+                "z_poly": list(self.z_poly)}
 
 
 @dataclass(frozen=True)

@@ -178,9 +178,11 @@ class CollapseBlend(NamedTuple):
     dlnHc_dlnx: np.ndarray   # d ln H̄_c/d ln x
     lnc2_gap: np.ndarray     # ln c²_c − ln c²_hs
     dlnc2c_dlnx: np.ndarray  # d ln c²_c/d ln x
+    dlnHc_dz: np.ndarray     # d ln H̄_c/d z
+    dlnc2c_dz: np.ndarray    # d ln c²_c/d z
 
 
-def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0) -> CollapseBlend:
+def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> CollapseBlend:
     """Blend the half-space values with the whole-body collapse limits (module docstring).
 
     Parameters
@@ -190,19 +192,21 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0) -> CollapseBlend
     x : finite-size ratio (a/R or a/ρ), > 0.
     coeffs : coefficient set; without a collapse block the inputs are returned (w = 0).
     n : effective hardening exponent.
+    z : R/ρ − 1, curvature of the pressing surface relative to the body (0: flat interface).
 
     Log derivatives of the result follow from those of the inputs:
     d ln H̄ = (1 − w) d ln H̄_hs + w d ln H̄_c and
     d ln c² = (1 − w) d ln c²_hs + w d ln c²_c + (ln c²_c − ln c²_hs) dw,
     dw = k w (1 − w) (d ln H̄_hs − d ln H̄_c).
     """
-    H_hs, c2_hs, x, n = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (H_hs, c2_hs, x, n)))
+    H_hs, c2_hs, x, n, z = np.broadcast_arrays(
+        *(np.asarray(v, dtype=float) for v in (H_hs, c2_hs, x, n, z)))
     zero = np.zeros_like(H_hs)
     if not coeffs.has_collapse:
-        return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero)
+        return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero, zero, zero)
     k = coeffs.collapse_sharpness
-    lnHc, sHc = coeffs.collapse_H_bar.log_and_slope(x, n)
-    lncc, scc = coeffs.collapse_c2.log_and_slope(x, n)
+    lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, z)
+    lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, z)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
         # w = r^k/(1 + r^k) and ln(1 + r^k), without overflow
@@ -212,27 +216,27 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0) -> CollapseBlend
         H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
         gap = np.where(w > 0.0, lncc - np.log(c2_hs), 0.0)
         c = c2_hs * np.exp(w * gap)
-    return CollapseBlend(H, c, w, sHc, gap, scc)
+    return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero)
 
 
-def H_bar(Lambda, coeffs: Coefficients, n=0.0, x=0.0):
+def H_bar(Lambda, coeffs: Coefficients, n=0.0, x=0.0, z=0.0):
     """Normalised hardness H̄ = p_m/σ_rep (seed eq. 1) with the finite-size factor and the
-    collapse blend at x."""
+    collapse blend at x (z = R/ρ − 1)."""
     H, _ = H_bar_and_slope(Lambda, coeffs, n)
     H = H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
     if not coeffs.has_collapse:
         return H
     c, _ = c2_and_slope(Lambda, coeffs, n)
-    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n).H_bar
+    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n, z).H_bar
 
 
-def c2(Lambda, coeffs: Coefficients, n=0.0, x=0.0):
+def c2(Lambda, coeffs: Coefficients, n=0.0, x=0.0, z=0.0):
     """Contact-area parameter c² = a²/(2hρ) (seed eq. 5) with the finite-size factor and the
-    collapse blend at x."""
+    collapse blend at x (z = R/ρ − 1)."""
     c, _ = c2_and_slope(Lambda, coeffs, n)
     c = c * finite_size_factor(x, coeffs.finite_size_c2)[0]
     if not coeffs.has_collapse:
         return c
     H, _ = H_bar_and_slope(Lambda, coeffs, n)
     H = H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
-    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n).c2
+    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n, z).c2

@@ -13,8 +13,8 @@ Log slopes used by the two-body solver and for dF/dh (m = d ln σ_f/d ln ε at �
 
 With a collapse block (``levels.collapse_blend``; y = finite-size ratio, n = effective
 exponent), the half-space p_hs = H̄_hs σ_rep and c²_hs are blended with the whole-body
-limits: ln r = ln p_hs − ln σ_rep − ln H̄_c(y), w = r^k/(1 + r^k),
-p_m = p_hs (1 + r^k)^(−1/k), c² = c²_hs^(1−w) c²_c(y)^w, and
+limits: ln r = ln p_hs − ln σ_rep − ln H̄_c(y, z), w = r^k/(1 + r^k),
+p_m = p_hs (1 + r^k)^(−1/k), c² = c²_hs^(1−w) c²_c(y, z)^w (z = x/y − 1 = R/ρ − 1), and
 
     ∂ln p_m = (1 − w) ∂ln p_hs + w (∂ln σ_rep + ∂ln H̄_c),
     ∂ln c²  = (1 − w) ∂ln c²_hs + w ∂ln c²_c + (ln c²_c − ln c²_hs) k w (1 − w) ∂ln r.
@@ -142,13 +142,18 @@ class BodyLaw:
         dp_x, dp_y = sH * (1.0 - m) + m, dfH
         dc_x, dc_y = sc * (1.0 - m), dfc
         if co.has_collapse and not math.isinf(mat.sigma_y):
-            b = collapse_blend(p / sig, c, y, co, self.n_eff)
+            # z = R/ρ − 1 = x/y − 1 with the ratio a/R (0 with the ratio a/ρ)
+            z1 = x / y if co.finite_size_ratio == "a_over_R" else np.ones_like(x)
+            b = collapse_blend(p / sig, c, y, co, self.n_eff, z1 - 1.0)
+            # limits L(y, z): ∂ln L/∂ln x = z1 ∂ln L/∂z, ∂ln L/∂ln y = ∂ln L/∂ln y|_z − z1 ∂ln L/∂z
+            Hc_x, Hc_y = z1 * b.dlnHc_dz, b.dlnHc_dlnx - z1 * b.dlnHc_dz
+            cc_x, cc_y = z1 * b.dlnc2c_dz, b.dlnc2c_dlnx - z1 * b.dlnc2c_dz
             w, v = b.w, co.collapse_sharpness * b.w * (1.0 - b.w) * b.lnc2_gap
-            dr_x, dr_y = dp_x - m, dp_y - b.dlnHc_dlnx  # ∂ln r
+            dr_x, dr_y = dp_x - m - Hc_x, dp_y - Hc_y  # ∂ln r
             p = b.H_bar * sig
-            dp_x, dp_y = (1.0 - w) * dp_x + w * m, (1.0 - w) * dp_y + w * b.dlnHc_dlnx
-            dc_x = (1.0 - w) * dc_x + v * dr_x
-            dc_y = (1.0 - w) * dc_y + w * b.dlnc2c_dlnx + v * dr_y
+            dp_x, dp_y = (1.0 - w) * dp_x + w * (m + Hc_x), (1.0 - w) * dp_y + w * Hc_y
+            dc_x = (1.0 - w) * dc_x + w * cc_x + v * dr_x
+            dc_y = (1.0 - w) * dc_y + w * cc_y + v * dr_y
             c = b.c2
         return BodyResponse(
             p_m=p, c2=c, Lambda=Lam, sigma_rep=sig,

@@ -12,8 +12,8 @@ from spherecontact.model.single import BodyLaw
 
 LIT = Coefficients.from_dict(LITERATURE)
 COLLAPSE = {
-    "H_bar": {"prefactor": 1.3, "exponent": 0.8, "x_poly": [0.2], "exp_poly": [0.5]},
-    "c2": {"prefactor": 0.9, "exponent": 0.0, "x_poly": [-0.3, 0.3], "exp_poly": []},
+    "H_bar": {"prefactor": 1.3, "exponent": 0.8, "x_poly": [0.2], "exp_poly": [0.5], "z_poly": [0.2]},
+    "c2": {"prefactor": 0.9, "exponent": 0.0, "x_poly": [-0.3, 0.3], "exp_poly": [], "z_poly": [0.3, -0.1]},
     "sharpness": 1.6,
 }
 
