@@ -36,8 +36,10 @@ KNOWN = {
     "level_II": {"H_bar_shape": [0.5], "c2_shape": [-0.5], "smooth": True},
     "hardening_exponent": {"method": "secant_loglog", "eps_lo": 0.01, "eps_hi": 0.1},
     "finite_size": {"ratio": "a_over_R", "H_bar": [0.3], "c2": [0.1]},
-    "collapse": {"H_bar": {"prefactor": 1.2, "exponent": 0.8, "x_poly": [0.0], "exp_poly": [0.5], "z_poly": []},
-                 "c2": {"prefactor": 0.9, "exponent": 0.0, "x_poly": [-0.3], "exp_poly": [], "z_poly": []},
+    "collapse": {"H_bar": {"prefactor": 1.2, "exponent": 0.8, "x_poly": [0.0], "exp_poly": [0.5],
+                           "z_poly": []},
+                 "c2": {"prefactor": 0.9, "exponent": 0.0, "x_poly": [-0.3], "exp_poly": [],
+                        "z_poly": []},
                  "sharpness": 2.0},
     "references": {},
 }
