@@ -24,7 +24,7 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients
-from ..model.single import BodyLaw, effective_exponent
+from ..model.single import BodyLaw, curvature_ratio, effective_exponent
 from .dataset import Dataset
 
 #: collapse c²_c is parametrised by its value and slopes at this a/R
@@ -51,7 +51,7 @@ class Form:
     n_collapse_c: int = 1       # x_poly terms of c²_c
     n_collapse_nH: int = 1      # exp_poly (hardening) terms of H̄_c
     n_collapse_nc: int = 1      # ... of c²_c
-    n_collapse_zH: int = 0      # z_poly (curvature of the pressing surface) terms of H̄_c
+    n_collapse_zH: int = 1      # z_poly (curvature of the pressing surface) terms of H̄_c
     n_collapse_zc: int = 1      # ... of c²_c
     ratio: str = "a_over_R"     # finite-size ratio
     eps_lo: float = 0.01        # secant of the effective hardening exponent
@@ -164,7 +164,8 @@ def predict_exact(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.nda
     for i, curve in enumerate(ds.curves):
         m = ds.run == i
         law = BodyLaw(curve.material, coeffs)
-        r = law.response(ds.x_rho[m], ds.x_R[m] if ratio_R else ds.x_rho[m])
+        z = curvature_ratio(curve.radius, curve.rho)
+        r = law.response(ds.x_rho[m], ds.x_R[m] if ratio_R else ds.x_rho[m], z)
         p[m] = r.p_m
         c[m] = r.c2
     return p, c
@@ -202,7 +203,9 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     Lam = np.where(elastic, 0.0, ds.E_prime * ds.x_rho / np.where(elastic, 1.0, sig))
     ratio_R = coeffs.finite_size_ratio == "a_over_R"
     y = ds.x_R if ratio_R else ds.x_rho
-    z = ds.x_rho / ds.x_R - 1.0 if ratio_R else 0.0  # R/ρ − 1
+    z = ds.cache.get("z")
+    if z is None:  # R/ρ − 1 of the rigid partner (ρ = Hertz relative radius)
+        z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
     H, _ = levels.H_bar_and_slope(Lam, coeffs, n_eff)
     c, _ = levels.c2_and_slope(Lam, coeffs, n_eff)
     H = H * levels.finite_size_factor(y, coeffs.finite_size_H_bar)[0]

@@ -22,7 +22,8 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
 * large-deformation collapse (schema 2, optional; same ratio x): the half-space values
   H̄_hs, c²_hs above are blended with limits of the whole body,
   L(x, n, z) = prefactor · x^(−exponent) · exp(Σ_k x_poly[k] x^(k+1) + Σ_k exp_poly[k] n^(k+1)
-  + Σ_k z_poly[k] z^(k+1)), z = R/ρ − 1 (0 for a flat interface),
+  + Σ_k z_poly[k] z^(k+1)), z = R/ρ_H − 1 with ρ_H the body's Hertz relative radius
+  (a constant of the pair: 0 for equal spheres, R/R_i against a rigid sphere),
   r = H̄_hs/H̄_c,  w = r^k/(1 + r^k)  (k = sharpness),
   H̄ = H̄_hs (1 + r^k)^(−1/k)   (smooth minimum of H̄_hs and H̄_c),
   c² = c²_hs^(1−w) · c²_c^w;  H̄_c → ∞ as x → 0 (exponent > 0), so w → 0 and the
@@ -213,9 +214,9 @@ class CollapseLimit:
     """L(x, n, z) = prefactor · x^(−exponent)
     · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1) + Σ z_poly[k] z^(k+1)).
 
-    x: finite-size ratio, n: effective hardening exponent, z = R/ρ − 1: curvature of the
-    surface pressing the body relative to the body's own (0 for a flat interface, i.e.
-    equal spheres; R/R_i for a rigid sphere of radius R_i).
+    x: finite-size ratio, n: effective hardening exponent, z = R/ρ_H − 1: curvature of the
+    surface pressing the body relative to the body's own, with ρ_H the Hertz relative
+    radius E'R*/E* (0 for equal spheres; R/R_i against a rigid sphere of radius R_i).
     """
 
     prefactor: float

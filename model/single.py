@@ -14,10 +14,15 @@ Log slopes used by the two-body solver and for dF/dh (m = d ln σ_f/d ln ε at �
 With a collapse block (``levels.collapse_blend``; y = finite-size ratio, n = effective
 exponent), the half-space p_hs = H̄_hs σ_rep and c²_hs are blended with the whole-body
 limits: ln r = ln p_hs − ln σ_rep − ln H̄_c(y, z), w = r^k/(1 + r^k),
-p_m = p_hs (1 + r^k)^(−1/k), c² = c²_hs^(1−w) c²_c(y, z)^w (z = x/y − 1 = R/ρ − 1), and
+p_m = p_hs (1 + r^k)^(−1/k), c² = c²_hs^(1−w) c²_c(y, z)^w, and
 
     ∂ln p_m = (1 − w) ∂ln p_hs + w (∂ln σ_rep + ∂ln H̄_c),
     ∂ln c²  = (1 − w) ∂ln c²_hs + w ∂ln c²_c + (ln c²_c − ln c²_hs) k w (1 − w) ∂ln r.
+
+z is the curvature ratio R/ρ_H − 1 of the body with ρ_H its Hertz (Level I) relative
+radius, a constant of the pair (:func:`curvature_ratio`): 0 for equal spheres (flat
+interface), R/R_i against a rigid sphere of radius R_i. Being constant it leaves
+p_m(x) monotone in 1/ρ, so the κ solve keeps a single root.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from .levels import collapse_blend, finite_size_factor, levels_scalar_n
 from .material import Material
 
 __all__ = [
+    "curvature_ratio",
     "flow_log_slope",
     "effective_exponent",
     "BodyResponse",
@@ -58,6 +64,18 @@ def flow_log_slope(material: Material, eps) -> np.ndarray:
         return np.zeros_like(e)
     t = material.K * e**material.n
     return material.n * t / (material.sigma_y + t)
+
+
+def curvature_ratio(radius, rho_hertz):
+    """z = R/ρ_H − 1 of a body of radius R whose Hertz relative radius is ρ_H (vectorised).
+
+    ρ_H = E'_i R*/E* (DESIGN §3): 0 for equal spheres, R/R_i against a rigid sphere of
+    radius R_i; 0 for a flat body (R = inf, no collapse).
+    """
+    R = np.asarray(radius, dtype=float)
+    with np.errstate(invalid="ignore"):
+        z = np.where(np.isinf(R), 0.0, R / np.asarray(rho_hertz, dtype=float) - 1.0)
+    return float(z) if z.ndim == 0 else z
 
 
 def effective_exponent(material: Material, coeffs: Coefficients) -> float:
@@ -117,8 +135,10 @@ class BodyLaw:
     def E_prime(self) -> float:
         return self.material.E_prime
 
-    def response(self, x, y=None) -> BodyResponse:
-        """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ)."""
+    def response(self, x, y=None, z: float = 0.0) -> BodyResponse:
+        """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
+        ``z`` the curvature ratio of the collapse limits (a constant of the pair,
+        :func:`curvature_ratio`)."""
         mat, co = self.material, self.coeffs
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
@@ -142,18 +162,13 @@ class BodyLaw:
         dp_x, dp_y = sH * (1.0 - m) + m, dfH
         dc_x, dc_y = sc * (1.0 - m), dfc
         if co.has_collapse and not math.isinf(mat.sigma_y):
-            # z = R/ρ − 1 = x/y − 1 with the ratio a/R (0 with the ratio a/ρ)
-            z1 = x / y if co.finite_size_ratio == "a_over_R" else np.ones_like(x)
-            b = collapse_blend(p / sig, c, y, co, self.n_eff, z1 - 1.0)
-            # limits L(y, z): ∂ln L/∂ln x = z1 ∂ln L/∂z, ∂ln L/∂ln y = ∂ln L/∂ln y|_z − z1 ∂ln L/∂z
-            Hc_x, Hc_y = z1 * b.dlnHc_dz, b.dlnHc_dlnx - z1 * b.dlnHc_dz
-            cc_x, cc_y = z1 * b.dlnc2c_dz, b.dlnc2c_dlnx - z1 * b.dlnc2c_dz
+            b = collapse_blend(p / sig, c, y, co, self.n_eff, z)
             w, v = b.w, co.collapse_sharpness * b.w * (1.0 - b.w) * b.lnc2_gap
-            dr_x, dr_y = dp_x - m - Hc_x, dp_y - Hc_y  # ∂ln r
+            dr_x, dr_y = dp_x - m, dp_y - b.dlnHc_dlnx  # ∂ln r
             p = b.H_bar * sig
-            dp_x, dp_y = (1.0 - w) * dp_x + w * (m + Hc_x), (1.0 - w) * dp_y + w * Hc_y
-            dc_x = (1.0 - w) * dc_x + w * cc_x + v * dr_x
-            dc_y = (1.0 - w) * dc_y + w * cc_y + v * dr_y
+            dp_x, dp_y = (1.0 - w) * dp_x + w * m, (1.0 - w) * dp_y + w * b.dlnHc_dlnx
+            dc_x = (1.0 - w) * dc_x + v * dr_x
+            dc_y = (1.0 - w) * dc_y + w * b.dlnc2c_dlnx + v * dr_y
             c = b.c2
         return BodyResponse(
             p_m=p, c2=c, Lambda=Lam, sigma_rep=sig,
@@ -184,7 +199,8 @@ def indent(material: Material, a, rho: float, radius: float | None = None,
     material : deformable material.
     a : contact radius (array), > 0.
     rho : relative radius ρ of the rigid surface seen by the body.
-    radius : body radius R (for the finite-size ratio a/R); defaults to ρ.
+    radius : body radius R (for the finite-size ratio a/R and the curvature ratio R/ρ − 1 of
+        the collapse limits); defaults to ρ.
     coeffs : coefficient set; default :func:`default_coefficients`.
 
     Returns
@@ -197,7 +213,7 @@ def indent(material: Material, a, rho: float, radius: float | None = None,
     x = a / rho
     R = rho if radius is None else radius
     y = x if co.finite_size_ratio == "a_over_rho" else a / R
-    r = law.response(x, y)
+    r = law.response(x, y, curvature_ratio(R, rho))
     F = math.pi * a**2 * r.p_m
     h = a * x / (2.0 * r.c2)
     dlnF = 2.0 + r.dlnp_dlnx + r.dlnp_dlny

@@ -28,7 +28,7 @@ import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
 from .roots import solve_increasing
-from .single import BodyLaw, BodyResponse
+from .single import BodyLaw, BodyResponse, curvature_ratio
 from .sphere import Sphere
 
 __all__ = ["UnifiedState", "UnifiedPair", "pair"]
@@ -101,12 +101,20 @@ class UnifiedPair:
             self.mode = "general"
         if self.mode == "general":
             self._u0 = math.log(s2.material.E_prime / s1.material.E_prime)
+        # curvature ratios z_i = R_i/ρ_i,H − 1 of the collapse limits, ρ_i,H = E'_i R*/E*
+        # (Hertz partition; constants of the pair, so the κ root stays unique)
+        self._z = {}
+        for law, s_, s_o in ((self.law1, s1, s2), (self.law2, s2, s1)):
+            if law is None:
+                continue
+            rho_h = self.R_star if s_o.is_rigid else s_.material.E_prime * self.R_star / self.E_star
+            self._z[id(law)] = curvature_ratio(s_.radius, rho_h)
 
     # ------------------------------------------------------------------ body responses
     def _body(self, law: BodyLaw, a, k, R) -> BodyResponse:
         x = a * k
         y = x if self._ratio_rho else a / R
-        return law.response(x, y)
+        return law.response(x, y, self._z[id(law)])
 
     def _g(self, a, u):
         """g = ln p_1 − ln p_2 at (a, u), its u-derivative, and both responses."""

@@ -97,13 +97,14 @@ def test_blend_is_a_smooth_minimum():
 @pytest.mark.parametrize("mat", [Material(E=500.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3),
                                  Material(E=50.0, nu=0.3, sigma_y=1.0),
                                  Material.from_table(200.0, 0.3, [0, 0.05, 0.5], [1.0, 1.5, 2.2])])
-def test_collapse_log_slopes_are_exact(mat):
+@pytest.mark.parametrize("z", [0.0, 0.6, -0.4])
+def test_collapse_log_slopes_are_exact(mat, z):
     law = BodyLaw(mat, v2())
     x = np.geomspace(0.01, 0.8, 9)
     y = 0.7 * x
-    r = law.response(x, y)
+    r = law.response(x, y, z)
     e = 1e-6
-    rx, ry = law.response(x * (1 + e), y), law.response(x, y * (1 + e))
+    rx, ry = law.response(x * (1 + e), y, z), law.response(x, y * (1 + e), z)
     np.testing.assert_allclose(np.log(rx.p_m / r.p_m) / e, r.dlnp_dlnx, atol=2e-5)
     np.testing.assert_allclose(np.log(ry.p_m / r.p_m) / e, r.dlnp_dlny, atol=2e-5)
     np.testing.assert_allclose(np.log(rx.c2 / r.c2) / e, r.dlnc2_dlnx, atol=2e-5)
@@ -121,7 +122,7 @@ def test_model_with_collapse_hertz_limit_and_fast_path(ratio):
     h = 1e-9
     st = contact(Sphere(R, m), wall, h, coeffs=co)
     assert st.F == pytest.approx(4.0 / 3.0 * m.E_prime * math.sqrt(R) * h**1.5, rel=1e-3)
-    for s2 in (wall, Sphere(R, m), Sphere(2.0, steel)):
+    for s2 in (wall, Sphere(R, m), Sphere(2.0, steel), Sphere(2.0, Material.rigid())):
         law = ContactLaw(Sphere(R, m), s2, coeffs=co, h_max=0.4)
         assert law.error["F"] < 1e-6
         hs = np.geomspace(1e-6, 0.3, 50)
@@ -174,3 +175,23 @@ def test_smooth_level_II_stiffness_is_continuous():
     d["level_II"].pop("smooth")
     with pytest.raises(ValueError, match=r"level_II\.smooth"):
         Coefficients.from_dict(d)
+
+
+def test_curvature_ratio_of_the_pair():
+    from spherecontact.model.single import curvature_ratio
+    from spherecontact.model.unified import UnifiedPair
+
+    m = Material(E=100.0, nu=0.3, sigma_y=1.0)
+    hard = Material(E=1e4, nu=0.3, sigma_y=1.0)
+    co = v2()
+    assert curvature_ratio(1.0, 1.0) == 0.0 and curvature_ratio(1.0, 0.5) == 1.0
+    p = UnifiedPair(Sphere(1.0, m), Sphere(2.0, Material.rigid()), co)
+    assert p._z[id(p.law1)] == pytest.approx(0.5)          # rigid sphere R_i = 2R: z = R/R_i
+    p = UnifiedPair(Sphere(1.0, m), Sphere(1.0, m), co)
+    assert p._z[id(p.law1)] == pytest.approx(0.0) and p._z[id(p.law2)] == pytest.approx(0.0)
+    p = UnifiedPair(Sphere(1.0, m), Sphere(1.0, hard), co)  # soft on stiff: nearly a rigid sphere
+    assert 0.9 < p._z[id(p.law1)] < 1.0 and -1.0 < p._z[id(p.law2)] < -0.9
+    # the κ equation stays monotone: F(h) continuous and increasing for a dissimilar pair
+    law = ContactLaw(Sphere(1.0, m), Sphere(2.0, hard), coeffs=co, h_max=0.4)
+    F, k = law.force(np.geomspace(1e-6, 0.35, 200))
+    assert np.all(np.diff(F) > 0) and np.all(k > 0)
