@@ -107,7 +107,12 @@ def monotonicity_penalty(co: Coefficients) -> np.ndarray:
     L = co.Lambda_I * (co.Lambda_III / co.Lambda_I) ** MONOTONE_T
     Lg, ng = np.meshgrid(L, MONOTONE_N)
     _, sH = levels.H_bar_and_slope(Lg.ravel(), co, ng.ravel())
-    return PENALTY * np.minimum(sH, 0.0)
+    out = [sH]
+    s, ds = levels.level_weight(L, co)
+    for x in (0.25, 0.5, 0.75, 1.0):  # with the finite-size factor's own Λ dependence
+        _, _, lf = levels.finite_size_by_level(x, s, ds, co.finite_size_H_bar, co.fs_H_bar_plastic)
+        out.append(sH + np.tile(np.broadcast_to(lf, s.shape), MONOTONE_N.size))
+    return PENALTY * np.minimum(np.concatenate(out), 0.0)
 
 
 def collapse_penalty(co: Coefficients) -> np.ndarray:
@@ -128,13 +133,13 @@ def collapse_penalty(co: Coefficients) -> np.ndarray:
 
 def finite_size_penalty(co: Coefficients) -> np.ndarray:
     """PENALTY · shortfall of the finite-size factors below ``FACTOR_MIN`` on 0 ≤ x ≤ 1."""
-    fH, _ = levels.finite_size_factor(COLLAPSE_X, co.finite_size_H_bar)
-    fc, _ = levels.finite_size_factor(COLLAPSE_X, co.finite_size_c2)
-    return PENALTY * np.concatenate([np.minimum(fH - FACTOR_MIN, 0.0), np.minimum(fc - FACTOR_MIN, 0.0)])
+    f = [levels.finite_size_factor(COLLAPSE_X, poly)[0] for poly in (
+        co.finite_size_H_bar, co.finite_size_c2, co.fs_H_bar_plastic, co.fs_c2_plastic)]
+    return PENALTY * np.minimum(np.concatenate(f) - FACTOR_MIN, 0.0)
 
 
 def _residuals(form: Form, ds: Dataset):
-    n_pen = MONOTONE_T.size * MONOTONE_N.size + 4 * COLLAPSE_X.size
+    n_pen = 5 * MONOTONE_T.size * MONOTONE_N.size + 6 * COLLAPSE_X.size
     bad = np.full(2 * ds.size + n_pen, 10.0)
 
     def f(params):

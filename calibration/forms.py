@@ -46,6 +46,7 @@ class Form:
     n_III_c: int = 1            # ... of c²_III(n)
     n_finite_H: int = 1         # finite-size polynomial terms of H̄
     n_finite_c: int = 1         # ... of c²
+    finite_by_level: bool = True  # separate Level I and Level III finite-size coefficients
     collapse: bool = True       # large-deformation collapse blend
     n_collapse_H: int = 1       # x_poly terms of H̄_c
     n_collapse_c: int = 1       # x_poly terms of c²_c
@@ -73,6 +74,9 @@ class Form:
         # finite-size factors 1 + f x: positive for every x <= 1 (f > -0.9)
         p += [(f"fs_H{k}", 0.3 if k == 0 else 0.0, -0.9, 3.0) for k in range(self.n_finite_H)]
         p += [(f"fs_c2{k}", 0.1 if k == 0 else 0.0, -0.9, 3.0) for k in range(self.n_finite_c)]
+        if self.finite_by_level:
+            p += [(f"fsp_H{k}", 0.0, -0.9, 3.0) for k in range(self.n_finite_H)]
+            p += [(f"fsp_c2{k}", 0.0, -0.9, 3.0) for k in range(self.n_finite_c)]
         if self.collapse:
             p += [("ln_Hc", math.log(1.2), math.log(0.2), math.log(10.0)),
                   ("Hc_exponent", 0.8, 0.05, 3.0)]
@@ -118,7 +122,11 @@ class Form:
             "hardening_exponent": {"method": "secant_loglog", "eps_lo": self.eps_lo,
                                    "eps_hi": self.eps_hi},
             "finite_size": {"ratio": self.ratio, "H_bar": seq("fs_H", self.n_finite_H),
-                            "c2": seq("fs_c2", self.n_finite_c)},
+                            "c2": seq("fs_c2", self.n_finite_c),
+                            "H_bar_plastic": seq("fsp_H" if self.finite_by_level else "fs_H",
+                                                 self.n_finite_H),
+                            "c2_plastic": seq("fsp_c2" if self.finite_by_level else "fs_c2",
+                                              self.n_finite_c)},
             "collapse": None,
             "references": {},
         }
@@ -208,8 +216,9 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
         z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
     H, _ = levels.H_bar_and_slope(Lam, coeffs, n_eff)
     c, _ = levels.c2_and_slope(Lam, coeffs, n_eff)
-    H = H * levels.finite_size_factor(y, coeffs.finite_size_H_bar)[0]
-    c = c * levels.finite_size_factor(y, coeffs.finite_size_c2)[0]
+    s_l, ds_l = levels.level_weight(Lam, coeffs)
+    H = H * levels.finite_size_by_level(y, s_l, ds_l, coeffs.finite_size_H_bar, coeffs.fs_H_bar_plastic)[0]
+    c = c * levels.finite_size_by_level(y, s_l, ds_l, coeffs.finite_size_c2, coeffs.fs_c2_plastic)[0]
     b = levels.collapse_blend(H, c, y, coeffs, n_eff, z)
     # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor (H̄ = 0 there)
     hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
@@ -226,8 +235,7 @@ def hertz_start() -> Coefficients:
 #: The candidate forms, by name. ``seed``: Level II straight in ln Λ (seed §2);
 #: ``poly``: polynomial Level II shape; ``smooth``: C¹ Hermite Level II with one shape
 #: term. All share the Level III, finite-size and collapse terms, so the CV comparison
-#: isolates the Level II form; ``no_collapse`` and ``a_over_rho`` test the
-#: large-deformation choices.
+#: isolates the Level II form; ``smooth2_fs`` tests level-dependent finite-size terms.
 FORMS: dict[str, Form] = {
     "seed": Form("seed", "Level II straight in ln Λ (seed §2); kinks at Λ_I and Λ_III"),
     "poly": Form("poly", "Level II cubic in t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) (2 shape terms each); "
@@ -237,6 +245,8 @@ FORMS: dict[str, Form] = {
                    n_shape_c=1),
     "smooth2": Form("smooth2", "as smooth, 2 shape terms each", smooth=True, n_shape_H=2,
                     n_shape_c=2),
+    "smooth2_fs": Form("smooth2_fs", "as smooth2, one finite-size coefficient for all levels",
+                       smooth=True, n_shape_H=2, n_shape_c=2, finite_by_level=False),
 }
 #: forms compared by cross-validation in every calibration
-CANDIDATES = ("seed", "poly", "smooth", "smooth2")
+CANDIDATES = ("seed", "poly", "smooth", "smooth2", "smooth2_fs")

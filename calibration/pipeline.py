@@ -16,6 +16,7 @@ the chosen Level II form.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import math
 import time
@@ -183,7 +184,13 @@ def load_runs(db_path, include_stopped: bool = True):
     dates = sorted(str(run.provenance.get("date_utc", "")) for _, run in pairs)
     partial = [{"key": r.key, "case": r.case, "h_last": float(run.h[-1]), "reason": r.reason}
                for r, run in pairs if r.status == "stopped"]
-    source = {"path": str(db_path), "content_hash": db.content_hash, "date": dates[-1][:10] or None,
+    h = hashlib.sha256()  # the data the fit sees: keys, statuses and the curves h, F, a
+    for r, run in sorted(pairs, key=lambda p: p[0].key):
+        h.update(f"{r.key}\0{r.status}\0".encode())
+        for arr in (run.h, run.F, run.a):
+            h.update(np.ascontiguousarray(arr, dtype="<f8").tobytes())
+    source = {"path": str(db_path), "content_hash": db.content_hash,
+              "calibration_runs_hash": h.hexdigest(), "date": dates[-1][:10] or None,
               "runs": [{"key": r.key, "case": r.case} for r, _ in pairs], "left_out": left_out,
               "partial": partial}
     return [(f"{r.case} [{r.key}]", run) for r, run in pairs], source
@@ -209,6 +216,10 @@ def coefficient_file(cal: Calibration) -> dict:
         "fe_dataset": {
             "path": cal.source.get("path"),
             "content_hash": cal.source.get("content_hash"),
+            "calibration_runs_hash": cal.source.get("calibration_runs_hash"),
+            "hashes": "content_hash: the whole database when calibrated (spherecontact.data); "
+                      "calibration_runs_hash: SHA-256 of the keys, statuses and curves h, F, a of "
+                      "the runs used (unchanged when other sets are added)",
             "set": "calibration",
             "runs": len(ds.curves),
             "materials": len(ds.groups),

@@ -18,7 +18,9 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   m₀ = H̄_I ln(Λ_III/Λ_I)/(H̄_III − H̄_I) for H̄ (d ln H̄/d ln Λ = 1 of Hertz at Λ_I) and
   m₀ = 0 for c²; the slope is 0 at Λ_III. q and dq/dΛ are then continuous (F(h) is C¹);
 * finite size, geometric ratio x (a/ρ_i or a/R_i):  q → q · (1 + Σ_k coeffs[k] x^(k+1)),
-  which vanishes as x → 0;
+  which vanishes as x → 0; in schema 2 the coefficients move from their Level I values
+  (``H_bar``, ``c2``) to their Level III values (``H_bar_plastic``, ``c2_plastic``) with
+  the level weight s = 3t² − 2t³ (t of Level II clipped to [0, 1]), which is C¹;
 * large-deformation collapse (schema 2, optional; same ratio x): the half-space values
   H̄_hs, c²_hs above are blended with limits of the whole body,
   L(x, n, z) = prefactor · x^(−exponent) · exp(Σ_k x_poly[k] x^(k+1) + Σ_k exp_poly[k] n^(k+1)
@@ -268,6 +270,8 @@ class Coefficients:
     finite_size_ratio: str
     finite_size_H_bar: tuple[float, ...]
     finite_size_c2: tuple[float, ...]
+    finite_size_H_bar_plastic: tuple[float, ...] | None = None  # None: same as the above
+    finite_size_c2_plastic: tuple[float, ...] | None = None
     collapse_H_bar: CollapseLimit | None = None
     collapse_c2: CollapseLimit | None = None
     collapse_sharpness: float = 0.0
@@ -328,7 +332,14 @@ class Coefficients:
         cH = cc = None
         k = 0.0
         smooth = False
+        fsHp = fscp = None
         if version >= 2:
+            for key in ("H_bar_plastic", "c2_plastic"):
+                if key not in fs:
+                    raise ValueError(f"coefficients: missing key 'finite_size.{key}' (required by "
+                                     "schema_version 2)")
+            fsHp = _poly(fs, "H_bar_plastic", "finite_size.")
+            fscp = _poly(fs, "c2_plastic", "finite_size.")
             if "smooth" not in lev2:
                 raise ValueError("coefficients: missing key 'level_II.smooth' (required by "
                                  "schema_version 2)")
@@ -372,6 +383,8 @@ class Coefficients:
             finite_size_ratio=_choice(fs, "ratio", "finite_size.", RATIOS),
             finite_size_H_bar=_poly(fs, "H_bar", "finite_size."),
             finite_size_c2=_poly(fs, "c2", "finite_size."),
+            finite_size_H_bar_plastic=fsHp,
+            finite_size_c2_plastic=fscp,
             collapse_H_bar=cH,
             collapse_c2=cc,
             collapse_sharpness=k,
@@ -402,6 +415,8 @@ class Coefficients:
         }
         if self.schema_version >= 2:
             d["level_II"]["smooth"] = self.level_II_smooth
+            d["finite_size"]["H_bar_plastic"] = list(self.fs_H_bar_plastic)
+            d["finite_size"]["c2_plastic"] = list(self.fs_c2_plastic)
             d["collapse"] = None if not self.has_collapse else {
                 "H_bar": self.collapse_H_bar.to_dict(), "c2": self.collapse_c2.to_dict(),
                 "sharpness": self.collapse_sharpness}
@@ -437,7 +452,25 @@ class Coefficients:
 
     @property
     def has_finite_size(self) -> bool:
-        return any(self.finite_size_H_bar) or any(self.finite_size_c2) or self.has_collapse
+        return (any(self.finite_size_H_bar) or any(self.finite_size_c2) or any(self.fs_H_bar_plastic)
+                or any(self.fs_c2_plastic) or self.has_collapse)
+
+    @property
+    def fs_H_bar_plastic(self) -> tuple[float, ...]:
+        """Finite-size coefficients of H̄ in Level III (schema 1: the same as in Level I)."""
+        p = self.finite_size_H_bar_plastic
+        return self.finite_size_H_bar if p is None else p
+
+    @property
+    def fs_c2_plastic(self) -> tuple[float, ...]:
+        p = self.finite_size_c2_plastic
+        return self.finite_size_c2 if p is None else p
+
+    @property
+    def finite_size_by_level(self) -> bool:
+        """True when the finite-size coefficients differ between Level I and Level III."""
+        return (self.fs_H_bar_plastic != self.finite_size_H_bar
+                or self.fs_c2_plastic != self.finite_size_c2)
 
     @property
     def has_collapse(self) -> bool:

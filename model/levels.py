@@ -11,7 +11,8 @@ in ln Λ, seed §2), so H̄ and c² are continuous at Λ_I and Λ_III. With
 ``level_II.smooth`` the shape is the cubic Hermite that also matches the slopes at
 both ends (Hertz at Λ_I, flat at Λ_III) plus t²(1 − t)²·Σ_k b_k t^k: H̄, c² are C¹. All functions are pure
 and vectorised; ``n`` is the effective hardening exponent (broadcast with Λ).
-The finite-size factor 1 + Σ_k f_k x^(k+1) multiplies H̄ and c² (x = a/ρ or a/R).
+The finite-size factor 1 + Σ_k f_k x^(k+1) multiplies H̄ and c² (x = a/ρ or a/R); its
+coefficients move from Level I to Level III values with the level weight s = 3t² − 2t³.
 The large-deformation collapse (:func:`collapse_blend`) then blends these half-space
 values with the whole-body limits H̄_c(x, n), c²_c(x, n):
 
@@ -35,6 +36,8 @@ __all__ = [
     "H_bar_and_slope",
     "c2_and_slope",
     "finite_size_factor",
+    "level_weight",
+    "finite_size_by_level",
     "collapse_blend",
     "CollapseBlend",
     "levels_scalar_n",
@@ -219,24 +222,64 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero)
 
 
+def level_weight(Lambda, coeffs: Coefficients):
+    """Level weight s = 3t² − 2t³ (0 in Level I, 1 in Level III) and ds/d ln Λ."""
+    Lam = np.asarray(Lambda, dtype=float)
+    L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
+    with np.errstate(divide="ignore"):
+        t = np.clip(np.log(Lam / coeffs.Lambda_I) / L, 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t), 6.0 * t * (1.0 - t) / L
+
+
+def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[float, ...]):
+    """Factor f = 1 + Σ_k [e_k (1 − s) + q_k s] x^(k+1) and its log slopes.
+
+    Parameters
+    ----------
+    x : finite-size ratio; s, ds : level weight and ds/d ln Λ (:func:`level_weight`);
+    elastic, plastic : coefficients e_k (Level I) and q_k (Level III).
+
+    Returns
+    -------
+    f, d ln f/d ln x, d ln f/d ln Λ.
+    """
+    x = np.asarray(x, dtype=float)
+    if elastic == plastic:
+        f, dx = finite_size_factor(x, elastic)
+        return f, dx, np.zeros_like(f)
+    fe, de = finite_size_factor(x, elastic)
+    fp, dp = finite_size_factor(x, plastic)
+    f = (1.0 - s) * fe + s * fp
+    return f, ((1.0 - s) * fe * de + s * fp * dp) / f, (fp - fe) * ds / f
+
+
+def _factors(Lambda, x, coeffs: Coefficients):
+    """Finite-size factors of H̄ and c² at (Λ, x)."""
+    s, ds = level_weight(Lambda, coeffs)
+    fH = finite_size_by_level(x, s, ds, coeffs.finite_size_H_bar, coeffs.fs_H_bar_plastic)[0]
+    fc = finite_size_by_level(x, s, ds, coeffs.finite_size_c2, coeffs.fs_c2_plastic)[0]
+    return fH, fc
+
+
 def H_bar(Lambda, coeffs: Coefficients, n=0.0, x=0.0, z=0.0):
     """Normalised hardness H̄ = p_m/σ_rep (seed eq. 1) with the finite-size factor and the
     collapse blend at x (z = R/ρ − 1)."""
     H, _ = H_bar_and_slope(Lambda, coeffs, n)
-    H = H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
+    fH, fc = _factors(Lambda, x, coeffs)
+    H = H * fH
     if not coeffs.has_collapse:
         return H
     c, _ = c2_and_slope(Lambda, coeffs, n)
-    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n, z).H_bar
+    return collapse_blend(H, c * fc, np.maximum(x, 1e-300), coeffs, n, z).H_bar
 
 
 def c2(Lambda, coeffs: Coefficients, n=0.0, x=0.0, z=0.0):
     """Contact-area parameter c² = a²/(2hρ) (seed eq. 5) with the finite-size factor and the
     collapse blend at x (z = R/ρ − 1)."""
     c, _ = c2_and_slope(Lambda, coeffs, n)
-    c = c * finite_size_factor(x, coeffs.finite_size_c2)[0]
+    fH, fc = _factors(Lambda, x, coeffs)
+    c = c * fc
     if not coeffs.has_collapse:
         return c
     H, _ = H_bar_and_slope(Lambda, coeffs, n)
-    H = H * finite_size_factor(x, coeffs.finite_size_H_bar)[0]
-    return collapse_blend(H, c, np.maximum(x, 1e-300), coeffs, n, z).c2
+    return collapse_blend(H * fH, c, np.maximum(x, 1e-300), coeffs, n, z).c2

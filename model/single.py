@@ -9,7 +9,10 @@ finite-size ratio when it is a/R):
 
 Log slopes used by the two-body solver and for dF/dh (m = d ln σ_f/d ln ε at ε_rep):
 
-    ∂ln p_m/∂ln x = (d ln H̄/d ln Λ)(1 − m) + m,   ∂ln c²/∂ln x = (d ln c²/d ln Λ)(1 − m).
+    ∂ln p_m/∂ln x = (d ln H̄/d ln Λ)(1 − m) + m,   ∂ln c²/∂ln x = (d ln c²/d ln Λ)(1 − m),
+
+where H̄ and c² include the finite-size factor f(y, Λ) (its Λ-dependence through the
+level weight enters d/d ln Λ; y is the finite-size ratio).
 
 With a collapse block (``levels.collapse_blend``; y = finite-size ratio, n = effective
 exponent), the half-space p_hs = H̄_hs σ_rep and c²_hs are blended with the whole-body
@@ -34,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
-from .levels import collapse_blend, finite_size_factor, levels_scalar_n
+from .levels import collapse_blend, finite_size_by_level, level_weight, levels_scalar_n
 from .material import Material
 
 __all__ = [
@@ -155,12 +158,13 @@ class BodyLaw:
         H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III)
         with np.errstate(invalid="ignore"):
             p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
-        fH, dfH = finite_size_factor(y, co.finite_size_H_bar)
-        fc, dfc = finite_size_factor(y, co.finite_size_c2)
+        s_l, ds_l = level_weight(Lam, co)
+        fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic)
+        fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic)
         piece = lev + 3 * _segment(mat, eps)
         p, c = p * fH, c * fc
-        dp_x, dp_y = sH * (1.0 - m) + m, dfH
-        dc_x, dc_y = sc * (1.0 - m), dfc
+        dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
+        dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
         if co.has_collapse and not math.isinf(mat.sigma_y):
             b = collapse_blend(p / sig, c, y, co, self.n_eff, z)
             w, v = b.w, co.collapse_sharpness * b.w * (1.0 - b.w) * b.lnc2_gap

@@ -35,7 +35,8 @@ KNOWN = {
     "c2_III": {"prefactor": 1.35, "exp_poly": [-0.8]},
     "level_II": {"H_bar_shape": [0.5], "c2_shape": [-0.5], "smooth": True},
     "hardening_exponent": {"method": "secant_loglog", "eps_lo": 0.01, "eps_hi": 0.1},
-    "finite_size": {"ratio": "a_over_R", "H_bar": [0.3], "c2": [0.1]},
+    "finite_size": {"ratio": "a_over_R", "H_bar": [0.3], "c2": [0.1], "H_bar_plastic": [0.4],
+                    "c2_plastic": [0.0]},
     "collapse": {"H_bar": {"prefactor": 1.2, "exponent": 0.8, "x_poly": [0.0], "exp_poly": [0.5],
                            "z_poly": []},
                  "c2": {"prefactor": 0.9, "exponent": 0.0, "x_poly": [-0.3], "exp_poly": [],
@@ -182,8 +183,9 @@ def test_dropping_a_material_keeps_the_fit_stable_on_the_shipped_database():
     if coeffs.source != "calibration":
         pytest.skip("data/coefficients.json is not a calibration yet")
     runs, source = load_runs(SHIPPED_DB)
-    if source["content_hash"] != coeffs.provenance.get("fe_dataset", {}).get("content_hash"):
-        pytest.skip("data/coefficients.json was calibrated on another state of the database")
+    if source["calibration_runs_hash"] != coeffs.provenance.get("fe_dataset", {}).get(
+            "calibration_runs_hash"):
+        pytest.skip("data/coefficients.json was calibrated on other calibration runs")
     ds = build_dataset(runs)
     form = FORMS[coeffs.provenance["form"]["name"]]
     full = fit(ds, form)
@@ -251,6 +253,7 @@ def test_cli_writes_a_loadable_file_byte_identical_on_rerun(tmp_path, small_db, 
     prov = d["provenance"]
     assert prov["created"] == "2026-01-01"  # from the database, not the wall clock
     assert len(prov["fe_dataset"]["content_hash"]) == 64
+    assert len(prov["fe_dataset"]["calibration_runs_hash"]) == 64
     assert set(prov["fit_residuals"]) == {"H_bar", "c2"}
     assert set(prov["fit_residuals"]["c2"]) == {"rms", "max"}
     assert set(prov["cross_validation"]) == {"seed", "smooth"}
