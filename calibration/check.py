@@ -88,7 +88,12 @@ def check_all(coeffs: Coefficients, calibration: list[Material]) -> list[Monoton
 
 @dataclass
 class RunError:
-    """Model against one FE run over its resolved range (a ≥ a_min): relative errors."""
+    """Model against one FE run over its resolved range (a ≥ a_min): relative errors.
+
+    ``F_*``, ``a_*``: against the FE curve as resampled for the fit (local linear fit in
+    ln–ln over ±1 grid step, which removes the force staircase of the surface mesh);
+    ``F_rms_inc``, ``a_rms_inc``: against every FE increment (staircase included).
+    """
 
     key: str
     group: str
@@ -98,21 +103,29 @@ class RunError:
     F_max: float
     a_rms: float
     a_max: float
-    F_err: np.ndarray    # per FE increment in the range
+    F_rms_inc: float
+    a_rms_inc: float
+    F_err: np.ndarray    # per grid point of the resampled curve
     a_err: np.ndarray
     h: np.ndarray
 
 
-def run_errors(curve: RunCurve, coeffs: Coefficients) -> RunError:
-    """F(h) and a(h) of the model (the FE scene: the body on a rigid flat or sphere) at the
-    FE increments with a ≥ a_min, relative to FE."""
-    sel = curve.a_fe >= curve.a_min
-    h = curve.h_fe[sel]
+def _model_Fa(curve: RunCurve, h: np.ndarray, coeffs: Coefficients):
     partner = WALL if math.isinf(curve.indenter_radius) else Sphere(curve.indenter_radius,
                                                                     Material.rigid())
     st = contact(Sphere(curve.radius, curve.material), partner, h, coeffs=coeffs)
-    eF = st.F / curve.F_fe[sel] - 1.0
-    ea = st.a / curve.a_fe[sel] - 1.0
+    return np.asarray(st.F), np.asarray(st.a)
+
+
+def run_errors(curve: RunCurve, coeffs: Coefficients) -> RunError:
+    """F(h) and a(h) of the model (the FE scene: the body on a rigid flat or sphere) against
+    the FE run, relative, over a ≥ a_min (class docstring)."""
     r = lambda e: float(np.sqrt(np.mean(e * e)))  # noqa: E731
-    return RunError(curve.key, curve.group, curve.scene, (float(h[0]), float(h[-1])), r(eF),
-                    float(np.abs(eF).max()), r(ea), float(np.abs(ea).max()), eF, ea, h)
+    F, a = _model_Fa(curve, curve.h, coeffs)
+    eF, ea = F / curve.F - 1.0, a / curve.a - 1.0
+    sel = curve.a_fe >= curve.a_min
+    Fi, ai = _model_Fa(curve, curve.h_fe[sel], coeffs)
+    eFi, eai = Fi / curve.F_fe[sel] - 1.0, ai / curve.a_fe[sel] - 1.0
+    return RunError(curve.key, curve.group, curve.scene, (float(curve.h[0]), float(curve.h[-1])),
+                    r(eF), float(np.abs(eF).max()), r(ea), float(np.abs(ea).max()), r(eFi), r(eai),
+                    eF, ea, curve.h)

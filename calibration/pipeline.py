@@ -234,6 +234,8 @@ def coefficient_file(cal: Calibration) -> dict:
         "model_error_per_run": {e.key: {"F": {"rms": round_sig(e.F_rms, 4), "max": round_sig(e.F_max, 4)},
                                         "a": {"rms": round_sig(e.a_rms, 4), "max": round_sig(e.a_max, 4)}}
                                 for e in cal.run_errors},
+        "model_error_note": "F(h), a(h) of the model in the FE scene against the resampled FE curves "
+                            "(relative), a >= a_min",
         "monotone_check": {"pairs": len(cal.checks), "passed": sum(c.ok for c in cal.checks)},
         "notes": "Residuals are relative (model/FE - 1) over the calibration points; "
                  "see reports/calibration/index.md.",
