@@ -17,8 +17,9 @@ them for any β, :class:`Dataset` holds what does not depend on it.
 Curves, not increments, carry the information: the FE force has a small staircase at
 large a/R (one step per surface node closing) and the increments are spaced unevenly.
 Each run is therefore resampled on a fixed grid in ln h (``per_decade`` nodes per
-decade, the same nodes for every run) by a local linear fit of ln F and ln a against
-ln h over the increments within one grid step of the node (triangular weights).
+decade, the same nodes for every run, plus the run's final approach) by a local linear
+fit of ln F and ln a against ln h over the increments within one grid step of the node
+(triangular weights).
 This is exact for power laws (Hertz: F ∝ h^{3/2}, a ∝ h^{1/2}) and averages the
 staircase over about two nodes of the surface mesh.
 
@@ -156,6 +157,9 @@ def run_curve(key: str, run, per_decade: int = PER_DECADE,
     d = math.log(10.0) / per_decade
     k = np.arange(math.ceil(lo / d - 1e-9), math.floor(hi / d + 1e-9) + 1)
     lng = k * d + math.log(R)
+    last = math.log(h[-1])
+    if lng.size and last - lng[-1] > 0.25 * d:  # the final approach (h_max) as one more node
+        lng = np.append(lng, last)
     if lng.size < 2:
         return None
     Fg, ag = resample(h, F, a, lng)

@@ -86,11 +86,12 @@ def test_hertz_run_gives_hertz_levels(indenter_radius):
         np.testing.assert_allclose(q["sigma_rep"], m.flow_stress(beta * ds.a / rho), rtol=1e-12)
     np.testing.assert_allclose(ds.c2, 0.5, rtol=1e-10)
     assert ds.a.min() >= 0.02 - 1e-12  # resolution filter at the default mesh density
-    # grid: 16 nodes per decade of h, shared by every run
-    lnh = np.log(ds.h)
+    # grid: 16 nodes per decade of h, shared by every run, plus the final approach
+    lnh = np.log(ds.h[:-1])
     np.testing.assert_allclose(np.diff(lnh), math.log(10.0) / 16, rtol=1e-9)
     np.testing.assert_allclose(lnh / (math.log(10.0) / 16), np.round(lnh / (math.log(10.0) / 16)),
                                atol=1e-9)
+    assert ds.h[-1] == pytest.approx(0.3, rel=1e-12)
 
 
 def test_resample_is_exact_for_power_laws_and_averages_a_staircase():
