@@ -23,7 +23,8 @@ def v2(collapse=COLLAPSE, ratio="a_over_R") -> Coefficients:
     d["schema_version"] = 2
     d["level_II"]["smooth"] = False
     d["collapse"] = copy.deepcopy(collapse)
-    d["finite_size"] = {"ratio": ratio, "H_bar": [0.3], "c2": [0.1]}
+    d["finite_size"] = {"ratio": ratio, "H_bar": [0.3], "c2": [0.1], "H_bar_plastic": [-0.2],
+                        "c2_plastic": [0.05]}
     return Coefficients.from_dict(d)
 
 
@@ -63,6 +64,7 @@ def test_null_collapse_equals_schema_1_model():
     d = LIT.to_dict()
     d["schema_version"] = 2
     d["level_II"]["smooth"] = False
+    d["finite_size"].update(H_bar_plastic=[], c2_plastic=[])
     d["collapse"] = None
     co = Coefficients.from_dict(d)
     m = Material(E=300.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)
