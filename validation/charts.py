@@ -78,9 +78,7 @@ def curves_chart(comp: Comparison, th: Thresholds, out: Path) -> Path:
             if not me.applies or pred is None:
                 continue
             color, ls = PEER_STYLE[name]
-            mask = ok.copy()
-            if name == "Johnson cavity":
-                mask &= comp.level == 2
+            mask = ok if me.mask is None else ok & me.mask
             top[q].plot(hR[mask], pred[mask], color=color, ls=ls, lw=1.1, label=name)
             bottom[q].plot(hR[mask], 100 * me.errors[q][mask], color=color, ls=ls, lw=1.0,
                            label=name)

@@ -59,6 +59,7 @@ class MethodErrors:
     a: np.ndarray | None = None
     h1: np.ndarray | None = None
     h2: np.ndarray | None = None
+    mask: np.ndarray | None = None     # points where the law is meant to hold (None: all)
     errors: dict = field(default_factory=dict)   # quantity → error array
     windows: dict = field(default_factory=dict)  # window → quantity → Summary
     levels: dict = field(default_factory=dict)   # level label → quantity → Summary
@@ -157,11 +158,11 @@ def compare_case(case: Case, coeffs: Coefficients | None, th: Thresholds) -> Com
     _errors_and_summaries(model, case, masks, labels, weights, resolved)
 
     peer_results = {}
-    for name, pred in predict_peers(case, lev).items():
+    for name, pred in predict_peers(case).items():
         if isinstance(pred, NotApplicable):
             peer_results[name] = MethodErrors(name, False, pred.reason)
             continue
-        me = MethodErrors(name, True, pred.note, pred.F, pred.a)
+        me = MethodErrors(name, True, pred.note, pred.F, pred.a, mask=pred.mask)
         _errors_and_summaries(me, case, masks, labels, weights,
                               resolved if pred.mask is None else resolved & pred.mask)
         peer_results[name] = me

@@ -14,9 +14,10 @@ approaches with the effective quantities their papers use:
   All three are fits or models of elastic–perfectly plastic spheres: a pair with a
   hardening body is outside them.
 * **Johnson's cavity model** is a hardness law p_m(a/R): it is compared as the force
-  π a_FE² p_m at the FE contact radius (its error is the error of p_m), on the points
-  in Level II only (its range), for one elastic–perfectly plastic body against a rigid
-  surface or a pair of equal materials (each body then sees ρ = 2R*).
+  π a_FE² p_m at the FE contact radius (its error is the error of p_m), in Johnson's own
+  elastic–plastic range 3 ≤ E'a/(Yρ) ≤ 40 (Johnson 1985 §6.3–6.5: first yield to fully
+  plastic), for one elastic–perfectly plastic body against a rigid surface or a pair of
+  equal materials (each body then sees ρ = 2R*).
 * **Biwa–Storåkers** is a rigid–plastic similarity law for one power-law material
   σ = σ_0 ε^n: perfect plasticity is n = 0; a Ludwik or tabulated curve is replaced by
   its secant power law through ε = 0.01 and 0.1. A pair of equal materials is two
@@ -35,11 +36,13 @@ from . import peers
 from .cases import Case, is_perfectly_plastic, spheres
 
 __all__ = ["PEERS", "PeerPrediction", "NotApplicable", "Equivalent", "equivalent", "predict_peers",
-           "power_law_fit"]
+           "power_law_fit", "CAVITY_RANGE"]
 
 PEERS = ("Hertz", "Jackson–Green 2005", "Kogut–Etsion 2002", "Thornton 1997",
          "Johnson cavity", "Biwa–Storåkers 1995")
 
+#: range of Johnson's parameter E'a/(Yρ) where the cavity model is meant to hold
+CAVITY_RANGE = (3.0, 40.0)
 #: strains of the secant power law replacing a non-power-law flow curve (Biwa–Storåkers)
 POWER_FIT_STRAINS = (0.01, 0.1)
 
@@ -100,11 +103,8 @@ def power_law_fit(m: Material) -> tuple[float, float]:
     return s_hi / hi**n, n
 
 
-def predict_peers(case: Case, level=None) -> dict:
-    """Every peer law on ``case``: name → :class:`PeerPrediction` or :class:`NotApplicable`.
-
-    ``level`` (optional, per FE point: 1, 2, 3) restricts Johnson's cavity model to Level II.
-    """
+def predict_peers(case: Case) -> dict:
+    """Every peer law on ``case``: name → :class:`PeerPrediction` or :class:`NotApplicable`."""
     eq = equivalent(case)
     s1, s2 = spheres(case)
     deformable = [s.material for s in (s1, s2) if not s.is_rigid]
@@ -149,11 +149,12 @@ def predict_peers(case: Case, level=None) -> dict:
     else:
         a_fe = case.a
         pm = Y.sigma_y * peers.johnson_cavity_hardness(a_fe / eq.rho, Y.E, Y.nu, Y.sigma_y)
-        mask = None if level is None else (np.asarray(level) == 2)
+        x = Y.E_prime * a_fe / (Y.sigma_y * eq.rho)
+        lo, hi = CAVITY_RANGE
         out["Johnson cavity"] = PeerPrediction(
-            math.pi * a_fe**2 * pm, None, basis="a", mask=mask,
-            note="p_m at the FE contact radius, Level II points" + (", ρ = 2R*" if eq.equal_materials
-                                                                  else ""))
+            math.pi * a_fe**2 * pm, None, basis="a", mask=(x >= lo) & (x <= hi),
+            note=f"p_m at the FE contact radius, for {lo:g} ≤ E'a/(σ_Y ρ) ≤ {hi:g}"
+                 + (", ρ = 2R*" if eq.equal_materials else ""))
 
     if not single:
         out["Biwa–Storåkers 1995"] = NotApplicable("similarity law for one power-law material; "

@@ -61,8 +61,8 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
         f"* FE data: `{source}` — {len(validation)} validation runs"
         + (f" ({len(stopped)} stopped early: {', '.join(stopped)})" if stopped else "")
         + f", {len(studies)} study runs.",
-        f"* Model coefficients: `{coeff_path}` (source: {coeffs.source}); Λ_I = {coeffs.Lambda_I:g}, "
-        f"Λ_III = {coeffs.Lambda_III:g}.",
+        f"* Model coefficients: `{coeff_path}` (source: {coeffs.source}); Λ_I = {coeffs.Lambda_I:.3g}, "
+        f"Λ_III = {coeffs.Lambda_III:.4g}.",
         f"* Thresholds: `{th_path}` — max |F error| ≤ {pct(th.F_max, 0)} %, max |a error| ≤ "
         f"{pct(th.a_max, 0)} % per run, from the end of Level I to h/R = {th.h_over_R_max:g}.",
     ]
@@ -108,7 +108,8 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            "Max |relative error| of F / of a in per cent, pooled over the runs of the class "
            "(a run can be in several classes); `[k/n]`: the law applies to k of the n runs; "
            "n/a: it applies to none (reasons in the class tables). Johnson's cavity model gives "
-           "p_m only: its F column is the error of p_m at the FE contact radius, in Level II.", "",
+           "p_m only: its F column is the error of p_m at the FE contact radius, in its own range "
+           "3 ≤ E'a/(σ_Y ρ) ≤ 40.", "",
            class_matrix(comps), "", "### Per class: max (RMS) errors and where a law does not apply",
            "", class_tables(comps), "", "## The model against FE, per run", "",
            "Max (RMS) relative error in per cent; h₁/h split: max absolute error of the fraction "
@@ -183,7 +184,7 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            "fewer than about three pole elements of the standard mesh) are left out everywhere.",
            "* Peer laws: `validation/peer_scenes.py` states how each law is applied (E*, R*, total "
            "approach for pairs; yield stress and ν of the body that yields first; Johnson's cavity "
-           "model as p_m in Level II; Biwa–Storåkers with a secant power law for non-power-law "
+           "model as p_m in 3 ≤ E'a/(σ_Y ρ) ≤ 40; Biwa–Storåkers with a secant power law for non-power-law "
            "curves) and where a law does not apply.", ""]
     path = out / "index.md"
     path.write_text("\n".join(md))
