@@ -288,3 +288,13 @@ def test_report_from_tiny_fe_runs(tmp_path):
     text = (out / "index.md").read_text()
     assert "flat" in text and "two-R2-Y2" in text and "dissimilar radii" in text
     assert (out / "curves_two_r2_y2.png").stat().st_size > 1000
+
+
+def test_scatter_measures_noise_not_curvature():
+    from spherecontact.validation.metrics import scatter
+
+    h = np.geomspace(1e-3, 0.3, 200)
+    smooth = 2 * h**1.3 * (1 + h)
+    assert scatter(h, smooth) < 1e-4
+    wiggle = smooth * (1 + 0.01 * (-1) ** np.arange(h.size))
+    assert 0.008 < scatter(h, wiggle) < 0.015  # ±1 % alternating noise (ends one-sided)

@@ -30,6 +30,7 @@ __all__ = [
     "level_labels",
     "LEVELS",
     "interp_loglog",
+    "scatter",
 ]
 
 #: point categories of the per-level tables
@@ -116,3 +117,29 @@ def interp_loglog(x_new, x, y) -> np.ndarray:
     inside = (xn >= x[0]) & (xn <= x[-1]) & (xn > 0)
     out[inside] = np.exp(np.interp(np.log(xn[inside]), np.log(x), np.log(y)))
     return out
+
+
+def scatter(h, y, mask=None, window: int = 11) -> float:
+    """Increment-to-increment scatter of a positive curve: max |ln y − smooth(ln y)|.
+
+    The smooth curve at each increment is a quadratic in ln h fitted by least squares to
+    the ``window`` increments centred on it; NaN with fewer points than that. Measures
+    the noise of an FE curve against which a model's max error is read.
+    """
+    h = np.asarray(h, dtype=float)
+    y = np.asarray(y, dtype=float)
+    ok = (h > 0) & (y > 0)
+    if mask is not None:
+        ok &= np.asarray(mask, dtype=bool)
+    n = int(ok.sum())
+    if n < window:
+        return math.nan
+    x, ly = np.log(h[ok]), np.log(y[ok])
+    k = window // 2
+    worst = 0.0
+    for i in range(n):
+        lo = min(max(0, i - k), n - window)
+        xs, ys = x[lo:lo + window], ly[lo:lo + window]
+        c = np.polyfit(xs - x[i], ys, 2)
+        worst = max(worst, abs(ly[i] - c[-1]))
+    return float(worst)

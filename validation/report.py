@@ -113,7 +113,9 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            class_matrix(comps), "", "### Per class: max (RMS) errors and where a law does not apply",
            "", class_tables(comps), "", "## The model against FE, per run", "",
            "Max (RMS) relative error in per cent; h₁/h split: max absolute error of the fraction "
-           "in percentage points. `to 0.5`: runs that go beyond the acceptance window.", "",
+           "in percentage points. `to 0.5`: runs that go beyond the acceptance window. FE scatter: "
+           "largest deviation of ln F (ln a) from a local quadratic over 11 increments — the noise "
+           "of the FE curve itself, against which a max error is read.", "",
            run_table(comps, th), "", "## Per level (all runs pooled, every FE point)", "",
            "Level of a point: the model's level of the body furthest into plasticity; "
            f"`large deformation`: h/R > {th.large_deformation_from:g}. Max (RMS) error %.", "",

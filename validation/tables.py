@@ -7,7 +7,7 @@ import math
 from .cases import CLASSES
 from .compare import MODEL, W_ACCEPT, W_LARGE, Comparison
 from .config import Thresholds
-from .metrics import EMPTY, LEVELS, Summary, pool
+from .metrics import EMPTY, LEVELS, Summary, pool, scatter
 from .peer_scenes import PEERS
 
 __all__ = ["markdown_table", "pct", "cell", "run_table", "class_tables", "class_matrix",
@@ -71,7 +71,8 @@ def run_table(comps: list[Comparison], th: Thresholds) -> str:
     header = ["run", "classes", "FE to h/R", "Level I ends at h/R", "F max (rms) %", "a max (rms) %"]
     if two:
         header += ["h₁ max (rms) %", "h₂ max (rms) %", "h₁/h split max (pp)"]
-    header += [f"F max % {W_LARGE}", f"a max % {W_LARGE}", "model ms/curve", "FE s/curve", "verdict"]
+    header += [f"F max % {W_LARGE}", f"a max % {W_LARGE}", "FE scatter F / a %", "model ms/curve",
+               "FE s/curve", "verdict"]
     rows = []
     for c in comps:
         m = c.model
@@ -83,7 +84,9 @@ def run_table(comps: list[Comparison], th: Thresholds) -> str:
             sp = m.summary(W_ACCEPT, "split")
             row += [cell(m.summary(W_ACCEPT, "h1")), cell(m.summary(W_ACCEPT, "h2")),
                     "—" if sp.empty else pct(sp.max)]
-        row += [pct(m.summary(W_LARGE, "F").max), pct(m.summary(W_LARGE, "a").max),
+        w = c.masks[W_ACCEPT]
+        noise = f"{pct(scatter(c.case.h, c.case.F, w))} / {pct(scatter(c.case.h, c.case.a, w))}"
+        row += [pct(m.summary(W_LARGE, "F").max), pct(m.summary(W_LARGE, "a").max), noise,
                 f"{1e3 * c.model_time_s:.2f}", f"{c.case.wall_s:.0f}",
                 "**fail**" if c.case.key in failed else "pass"]
         rows.append(row)
