@@ -76,6 +76,7 @@ class Calibration:
     run_errors: list[RunError]
     alternatives: dict[str, FitResult] = field(default_factory=dict)  # large-deformation options
     alternative_checks: dict[str, bool] = field(default_factory=dict)
+    form_checks: dict[str, bool] = field(default_factory=dict)  # monotone check per form tried
     source: dict = field(default_factory=dict)   # database path, hash, date, run keys, excluded
     timings: dict = field(default_factory=dict)
 
@@ -152,6 +153,7 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
     timings["total_s"] = time.perf_counter() - t0
     return Calibration(dataset=ds, fits=fits, cv=cv, chosen=chosen, checks=checks[chosen],
                        run_errors=errs, alternatives=alternatives, alternative_checks=alt_ok,
+                       form_checks=dict(checks_ok),
                        source=dict(source or {}), timings=timings)
 
 

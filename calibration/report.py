@@ -221,7 +221,8 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
                     _pct(p["c2"]["max"]), _pct(cv_score(cv)), f"{g}: {_pct(v)}"]
         else:
             row += ["—"] * 6
-        row.append("yes" if name == cal.chosen else "not checked")
+        ok = cal.form_checks.get(name)
+        row.append("not checked" if ok is None else ("yes" if ok else "NO"))
         L.append("| " + " | ".join(row) + " |")
     L.append("")
     for name, f in cal.fits.items():
