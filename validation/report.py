@@ -99,6 +99,11 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
                       f"{worst_point(c, 'a')}.")
     else:
         md.append(f"**PASS** — all {len(comps)} runs within the thresholds.")
+    stopped = [c for c in comps if c.case.status != "converged"]
+    if stopped:
+        md += ["", "Runs that stopped early are checked over the part the FE reached: "
+               + "; ".join(f"{c.case.label} to h/R = {c.h_over_R[-1]:.3g} ({c.case.reason})"
+                           for c in stopped) + "."]
     warned = sorted({w for c in comps for w in c.model_warnings})
     md += ["", "Model warnings while evaluating the validation runs: "
            + ("; ".join(warned) if warned else "none") + "."]
