@@ -63,9 +63,12 @@ def curves_chart(comp: Comparison, th: Thresholds, out: Path) -> Path:
     fig, ax = plt.subplots(2, ncol, figsize=(5.0 * ncol, 7.5), squeeze=False)
     top = {"F": ax[0, 0], "a": ax[0, 1]}
     bottom = {"F": ax[1, 0], "a": ax[1, 1]}
-    ok = hR > 0
-    lo_x = hR[ok & (c.a / comp.R_ref >= th.a_min_over_R)][:1]
-    x_lo = float(lo_x[0]) if lo_x.size else float(hR[ok][0])
+    ok = (hR > 0) & comp.resolved
+    lo_x = hR[ok][:1]
+    if not lo_x.size:  # no resolved point: draw them all
+        ok = hR > 0
+        lo_x = hR[ok][:1]
+    x_lo = float(lo_x[0])
     x_hi = float(hR[-1])
     for q in ("F", "a"):
         fe = c.F if q == "F" else c.a
@@ -143,7 +146,7 @@ def error_chart(comps: list[Comparison], th: Thresholds, out: Path, x: str,
         ls = "-" if i < 10 else "--"
         for k, q in enumerate(("F", "a")):
             e = 100 * comp.model.errors[q]
-            ok = xs > 0
+            ok = (xs > 0) & comp.resolved
             ax[k].plot(xs[ok], e[ok], color=color, ls=ls, lw=1.2,
                        label=comp.case.label if k == 0 else None)
     for k, q in enumerate(("F", "a")):

@@ -84,6 +84,7 @@ class Comparison:
     labels: np.ndarray        # "I", "II", "III", "large" per point
     start: float              # h/R where Level I ends (inf: never)
     masks: dict               # window → bool mask
+    resolved: np.ndarray      # FE contact radius resolved by the mesh (a/R ≥ a_min_over_R)
     model: MethodErrors
     peers: dict               # name → MethodErrors
     model_time_s: float       # one evaluation of the model curve on the run's grid
@@ -167,5 +168,5 @@ def compare_case(case: Case, coeffs: Coefficients | None, th: Thresholds) -> Com
                               resolved if pred.mask is None else resolved & pred.mask)
         peer_results[name] = me
     assert tuple(peer_results) == PEERS
-    return Comparison(case, classes(case), R, hR, lam, lev, labels, start, masks, model,
+    return Comparison(case, classes(case), R, hR, lam, lev, labels, start, masks, resolved, model,
                       peer_results, t_model, model_warnings)
