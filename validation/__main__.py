@@ -28,6 +28,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="reports/validation", help="output directory")
     p.add_argument("--set", default="validation", help="database set to validate on")
     p.add_argument("--studies-set", default="studies", help="database set of the FE studies")
+    p.add_argument("--studies-fallback", default="reports/fem",
+                   help="directory of FE verification runs (run_*.json) used for the studies when "
+                        "the database has no studies set ('' to disable)")
     return p
 
 
@@ -49,6 +52,13 @@ def main(argv: list[str] | None = None) -> int:
         if not validation:
             raise ValueError(f"{db}: no run in the set {args.set!r}")
         studies = load_cases(db, args.studies_set)
+        studies_source = f"database set `{args.studies_set}`"
+        if not studies and args.studies_fallback:
+            from .fem_reports import load_verification_runs
+
+            studies = load_verification_runs(args.studies_fallback)
+            studies_source = (f"FE verification runs `{args.studies_fallback}/run_*.json` (the database "
+                              f"has no `{args.studies_set}` set)")
         try:
             calibration = load_records(db, "calibration")
         except (KeyError, ValueError):
@@ -61,7 +71,8 @@ def main(argv: list[str] | None = None) -> int:
     skipped = [f"{r.case or r.key} ({r.status}: {r.reason})" for r in records if r.key not in compared]
     res = build_report(validation, studies, coeffs, th, args.out, source=str(db),
                        coeff_path=args.coefficients or "model default", th_path=args.thresholds,
-                       calibration_records=calibration, skipped=skipped)
+                       calibration_records=calibration, skipped=skipped,
+                       studies_source=studies_source)
     dt = time.perf_counter() - t0
     print(f"validation: {len(res.comparisons)} runs, report {res.path} ({len(res.pngs)} charts), "
           f"{dt:.1f} s")

@@ -73,7 +73,8 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
 
 def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficients | None,
                  th: Thresholds, out, *, source: str = "", coeff_path: str = "", th_path: str = "",
-                 calibration_records=None, skipped: list[str] | None = None) -> ReportResult:
+                 calibration_records=None, skipped: list[str] | None = None,
+                 studies_source: str = "") -> ReportResult:
     """Compare every validation run, run the studies, write ``out/index.md`` and the PNGs."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -84,6 +85,8 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
     fails = failures(comps, th)
     pngs: list[Path] = []
     md = _header(source, cf, coeff_path, th, th_path, validation, studies, skipped or [])
+    if studies_source:
+        md.append(f"* Study runs (speed–accuracy, stability): {studies_source}.")
 
     # ------------------------------------------------------------------ verdict
     md += ["", "## Verdict", ""]
