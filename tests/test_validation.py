@@ -298,3 +298,26 @@ def test_scatter_measures_noise_not_curvature():
     assert scatter(h, smooth) < 1e-4
     wiggle = smooth * (1 + 0.01 * (-1) ** np.arange(h.size))
     assert 0.008 < scatter(h, wiggle) < 0.015  # ±1 % alternating noise (ends one-sided)
+
+
+def test_study_runs_outside_the_database(tmp_path):
+    """Verification JSON (inputs from the verification plan) and study files (inputs stored)."""
+    import json
+
+    from spherecontact.validation.fem_reports import load_study_files, load_verification_runs
+    from spherecontact.validation.studies import variant
+
+    c = make_case("x", h=np.geomspace(2e-4, 0.3, 20))
+    curves = {k: v.tolist() for k, v in c.curves.items()}
+    (tmp_path / "run_standard_fine.json").write_text(json.dumps(
+        {"curves": curves, "status": "converged", "reason": "", "timings": {"wall_s": 900.0}}))
+    (tmp_path / "run_hertz.json").write_text("{}")  # elastic verification run: not a study
+    inputs = {**c.inputs, "options": {"strain_increment": 0.02}}
+    (tmp_path / "standard_de0.02.json").write_text(json.dumps(
+        {"inputs": inputs, "curves": curves, "status": "converged", "reason": "",
+         "timings": {"wall_s": 60.0}}, default=float))
+    (fine,) = load_verification_runs(tmp_path)
+    assert fine.name == "standard_fine" and fine.wall_s == 900.0
+    assert variant(fine, TH).mesh_density == 2.0 and variant(fine, TH).kind == "refinement"
+    (de,) = load_study_files(tmp_path)
+    assert variant(de, TH).strain_increment == 0.02 and de.label == "standard_de0.02"

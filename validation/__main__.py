@@ -31,6 +31,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--studies-fallback", default="reports/fem",
                    help="directory of FE verification runs (run_*.json) used for the studies when "
                         "the database has no studies set ('' to disable)")
+    p.add_argument("--study-runs", default="reports/validation/studies",
+                   help="directory of the validation's own study runs (*.json), used with the fallback")
     return p
 
 
@@ -54,11 +56,12 @@ def main(argv: list[str] | None = None) -> int:
         studies = load_cases(db, args.studies_set)
         studies_source = f"database set `{args.studies_set}`"
         if not studies and args.studies_fallback:
-            from .fem_reports import load_verification_runs
+            from .fem_reports import load_study_files, load_verification_runs
 
-            studies = load_verification_runs(args.studies_fallback)
-            studies_source = (f"FE verification runs `{args.studies_fallback}/run_*.json` (the database "
-                              f"has no `{args.studies_set}` set)")
+            studies = load_verification_runs(args.studies_fallback) + load_study_files(args.study_runs)
+            studies_source = (f"FE verification runs `{args.studies_fallback}/run_*.json` and study runs "
+                              f"`{args.study_runs}/*.json` (the database has no `{args.studies_set}` "
+                              "set)")
         try:
             calibration = load_records(db, "calibration")
         except (KeyError, ValueError):

@@ -1,14 +1,23 @@
-"""Study runs from the FE verification (``reports/fem/run_*.json``) when the database has none.
+"""Study runs outside the database: the FE verification runs and the validation's own study runs.
 
+Used for the speed–accuracy chart and the stability section only when the database
+holds no ``studies`` set (the report then names this source).
+
+**Verification runs.**
 ``make verify-fem`` saves each of its runs as JSON (curves, timings, residuals); their
 inputs are those of ``spherecontact.fem.verification.plan`` (ν = 0.3, σ_Y = 1, R = 1,
-rigid flat). The report uses them for the speed–accuracy chart and the stability
-section only when the database holds no ``studies`` set, and says so. Runs used:
+rigid flat). Runs used:
 
 * ``standard``, ``standard_fine`` (mesh density 2), ``standard_dt2`` (strain increment
   0.0025): the refinement series of the standard case (E/σ_Y = 200, h/R = 0.3);
 * ``lock_q4``, ``lock_q8r`` (and ``_fine``): the locking study (E/σ_Y = 10⁴);
 * ``large_*``: runs to h/R = 0.5 (the extreme-h/R study).
+
+**Study runs** (:data:`STUDY_VARIANTS`, written by ``python -m
+spherecontact.validation.fem_reports --out reports/validation/studies``): variants of
+the standard case the verification does not hold — oversized strain increments, the
+locking element on the standard case, an extreme approach h/R = 0.6. Each is a JSON
+file ``<name>.json`` with ``inputs``, ``curves``, ``status``, ``reason``, ``timings``.
 """
 
 from __future__ import annotations
@@ -21,10 +30,20 @@ import numpy as np
 
 from .cases import Case
 
-__all__ = ["STUDY_RUNS", "load_verification_runs"]
+__all__ = ["STUDY_RUNS", "STUDY_VARIANTS", "load_verification_runs", "load_study_files",
+           "run_study_variants"]
 
 STUDY_RUNS = ("standard", "standard_fine", "standard_dt2", "lock_q4", "lock_q8r", "lock_q4_fine",
               "lock_q8r_fine", "large_epp50", "large_epp500", "large_ludwik")
+
+
+#: the validation's own study runs: name → (strain_increment, element, h_max) of the standard case
+STUDY_VARIANTS = {
+    "standard_de0.01": (0.01, "q8r", 0.3),
+    "standard_de0.02": (0.02, "q8r", 0.3),
+    "standard_q4": (0.005, "q4", 0.3),
+    "standard_extreme0.6": (0.005, "q8r", 0.6),
+}
 
 
 def _inputs(spec: dict) -> dict:
@@ -70,3 +89,68 @@ def load_verification_runs(directory) -> list[Case]:
                         provenance={"timings": d.get("timings", {}), "wall_s": wall,
                                     "source": str(path)}))
     return out
+
+
+def _case(name: str, d: dict, inputs: dict, source: str) -> Case:
+    curves = {k: np.asarray(v, dtype=float) for k, v in d["curves"].items()}
+    wall = float(d.get("timings", {}).get("wall_s", math.nan))
+    params = {"scene": "flat", "mesh_density": float(inputs.get("mesh_density", 1.0)),
+              "strain_increment": float(inputs.get("options", {}).get("strain_increment", 0.005)),
+              "element": inputs.get("element", "q8r")}
+    return Case(key=f"file:{name}", set="studies", name=name, params=params, inputs=inputs,
+                curves=curves, status=d.get("status", "converged"), reason=d.get("reason", ""),
+                wall_s=wall, provenance={"timings": d.get("timings", {}), "wall_s": wall,
+                                         "source": source})
+
+
+def load_study_files(directory) -> list[Case]:
+    """Cases of the study-run files ``directory/*.json`` (empty list if none)."""
+    out = []
+    for path in sorted(Path(directory).glob("*.json")):
+        try:
+            d = json.loads(path.read_text())
+            out.append(_case(path.stem, d, d["inputs"], str(path)))
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+    return out
+
+
+def run_study_variants(out_dir, names=None) -> list[Path]:
+    """Run the missing :data:`STUDY_VARIANTS` one after another; write ``out_dir/<name>.json``."""
+    import time
+
+    from ..fem.io import run_indentation
+    from ..fem.solver import SolverOptions
+    from ..model import Material
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, (de, element, h_max) in STUDY_VARIANTS.items():
+        path = out_dir / f"{name}.json"
+        if (names and name not in names) or path.exists():
+            continue
+        t0 = time.perf_counter()
+        res = run_indentation(Material(E=200.0, nu=0.3, sigma_y=1.0), 1.0, h_max, element=element,
+                              options=SolverOptions(strain_increment=de, max_wall_s=1800.0))
+        timings = {k: float(v) for k, v in res.timings.items()}
+        timings.setdefault("wall_s", time.perf_counter() - t0)
+        inputs = json.loads(json.dumps(res.inputs, default=float))
+        d = {"inputs": inputs, "curves": {k: np.asarray(v).tolist() for k, v in res.curves.items()},
+             "status": res.status, "reason": res.reason, "timings": timings}
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(json.dumps(d))
+        tmp.replace(path)
+        written.append(path)
+        print(f"{name}: {res.status} ({res.reason}), {timings['wall_s']:.0f} s", flush=True)
+    return written
+
+
+if __name__ == "__main__":
+    import argparse
+
+    parser = argparse.ArgumentParser(description="Run the validation's own FE study runs.")
+    parser.add_argument("--out", default="reports/validation/studies")
+    parser.add_argument("names", nargs="*", help=f"subset of {', '.join(STUDY_VARIANTS)}")
+    args = parser.parse_args()
+    run_study_variants(args.out, args.names)

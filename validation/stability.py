@@ -30,7 +30,7 @@ from .cases import Case, reference_radius, spheres
 from .charts import DPI, pyplot
 from .config import Thresholds
 from .metrics import Summary, interp_loglog, relative_error, summarise, trapezoid_weights
-from .studies import Reference, energy_balance, standard_runs, variant
+from .studies import DEFAULTS, Reference, energy_balance, standard_runs, variant
 from .tables import markdown_table, pct
 
 __all__ = ["pair_error", "locking_section", "penalty_section", "increment_section",
@@ -221,6 +221,9 @@ def increment_section(cases: list[Case], ref: Reference | None, th: Thresholds, 
                             "rejected increments", "wall s", "F max (rms) %", "a max (rms) %",
                             "energy balance miss %", "status"], rows)
     de, sF, sa, eb, c = worst[-1]
+    if de <= DEFAULTS["strain_increment"] * (1 + 1e-9):
+        return (f"No run with a strain increment above the default Δε = "
+                f"{DEFAULTS['strain_increment']:g} in the studies; the series:\n\n" + table, path)
     text = (f"The largest increment, Δε = {de:g}: F up to {pct(sF.max, 2)} % and a up to "
             f"{pct(sa.max, 2)} % from the best estimate, energy balance missed by {pct(eb, 2)} % "
             f"({_status(c)}); the smallest, Δε = {worst[0][0]:g}: F {pct(worst[0][1].max, 2)} %.")
