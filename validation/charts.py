@@ -43,13 +43,23 @@ def slug(text: str) -> str:
 
 
 def representative(comps: list[Comparison]) -> list[Comparison]:
-    """One run per class (the first of the class not already chosen), in class order."""
+    """One run per class — converged before stopped, then the fewest classes (the purest
+    example), then by name — and the run with the largest model error of F."""
     chosen: list[Comparison] = []
+
+    def rank(c: Comparison):
+        return (c.case.status != "converged", len(c.classes), c.case.label)
+
     for cls in CLASSES:
-        members = [c for c in comps if cls in c.classes]
+        members = sorted((c for c in comps if cls in c.classes), key=rank)
         pick = next((c for c in members if c not in chosen), None)
         if pick is not None:
             chosen.append(pick)
+    scored = [c for c in comps if not c.model.summary(W_ACCEPT, "F").empty]
+    if scored:
+        worst = max(scored, key=lambda c: c.model.summary(W_ACCEPT, "F").max)
+        if worst not in chosen:
+            chosen.append(worst)
     return chosen
 
 

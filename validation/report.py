@@ -44,8 +44,10 @@ def worst_point(comp: Comparison, q: str) -> str:
     if not np.any(m):
         return "—"
     i = np.flatnonzero(m)[np.argmax(np.abs(e[m]))]
-    return (f"{100 * e[i]:+.1f} % at h/R {comp.h_over_R[i]:.3g} (Level {comp.labels[i]}, "
-            f"Λ {comp.Lambda[i]:.3g})")
+    where = f"Level {'I' * int(comp.level[i])}"
+    if comp.labels[i] == "large":
+        where += ", large deformation"
+    return f"{100 * e[i]:+.1f} % at h/R {comp.h_over_R[i]:.3g} ({where}, Λ {comp.Lambda[i]:.3g})"
 
 
 def _rel(path: Path, out: Path) -> str:
@@ -132,8 +134,9 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
     # ------------------------------------------------------------------ charts
     if comps:
         md += ["", "## Curves of representative runs", "",
-               "FE (black), model (blue dashed), peer laws where they apply; errors below; grey band: "
-               "threshold; vertical lines: end of Level I (dotted) and the window end.", ""]
+               "One run per class and the run with the largest F error. FE (black), model (blue "
+               "dashed), peer laws where they apply; errors below; grey band: threshold; vertical "
+               "lines: end of Level I (dotted) and the window end.", ""]
         for c in representative(comps):
             p = curves_chart(c, th, out)
             pngs.append(p)
