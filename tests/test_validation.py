@@ -298,6 +298,10 @@ def test_scatter_measures_noise_not_curvature():
     assert scatter(h, smooth) < 1e-4
     wiggle = smooth * (1 + 0.01 * (-1) ** np.arange(h.size))
     assert 0.008 < scatter(h, wiggle) < 0.015  # ±1 % alternating noise (ends one-sided)
+    from spherecontact.validation.metrics import smooth_loglog
+
+    assert np.allclose(smooth_loglog(h, smooth), smooth, rtol=1e-4)
+    assert np.max(np.abs(smooth_loglog(h, wiggle)[10:-10] / smooth - 1)) < 0.002
 
 
 def test_study_runs_outside_the_database(tmp_path):

@@ -56,9 +56,9 @@ def main(argv: list[str] | None = None) -> int:
         studies = load_cases(db, args.studies_set)
         studies_source = f"database set `{args.studies_set}`"
         if not studies and args.studies_fallback:
-            from .fem_reports import load_study_files, load_verification_runs
+            from .fem_reports import load_fallback
 
-            studies = load_verification_runs(args.studies_fallback) + load_study_files(args.study_runs)
+            studies = load_fallback(args.studies_fallback, args.study_runs)
             studies_source = (f"FE verification runs `{args.studies_fallback}/run_*.json` and study runs "
                               f"`{args.study_runs}/*.json` (the database has no `{args.studies_set}` "
                               "set)")

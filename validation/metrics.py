@@ -31,6 +31,7 @@ __all__ = [
     "LEVELS",
     "interp_loglog",
     "scatter",
+    "smooth_loglog",
 ]
 
 #: point categories of the per-level tables
@@ -119,27 +120,40 @@ def interp_loglog(x_new, x, y) -> np.ndarray:
     return out
 
 
+def smooth_loglog(h, y, window: int = 11) -> np.ndarray:
+    """ln y smoothed by a local quadratic in ln h over ``window`` increments, as y.
+
+    At each point, a least-squares quadratic through the ``window`` increments centred on
+    it (one-sided at the ends); points with h ≤ 0 or y ≤ 0 are returned unchanged.
+    """
+    h = np.asarray(h, dtype=float)
+    y = np.asarray(y, dtype=float)
+    out = y.copy()
+    ok = (h > 0) & (y > 0) & np.isfinite(y)
+    n = int(ok.sum())
+    if n < window:
+        return out
+    x, ly = np.log(h[ok]), np.log(y[ok])
+    k = window // 2
+    sm = np.empty(n)
+    for i in range(n):
+        lo = min(max(0, i - k), n - window)
+        sm[i] = np.polyfit(x[lo:lo + window] - x[i], ly[lo:lo + window], 2)[-1]
+    out[ok] = np.exp(sm)
+    return out
+
+
 def scatter(h, y, mask=None, window: int = 11) -> float:
     """Increment-to-increment scatter of a positive curve: max |ln y − smooth(ln y)|.
 
-    The smooth curve at each increment is a quadratic in ln h fitted by least squares to
-    the ``window`` increments centred on it; NaN with fewer points than that. Measures
-    the noise of an FE curve against which a model's max error is read.
+    The smooth curve is :func:`smooth_loglog`; NaN with fewer points than ``window``.
+    Measures the noise of an FE curve against which a model's max error is read.
     """
     h = np.asarray(h, dtype=float)
     y = np.asarray(y, dtype=float)
     ok = (h > 0) & (y > 0)
     if mask is not None:
         ok &= np.asarray(mask, dtype=bool)
-    n = int(ok.sum())
-    if n < window:
+    if ok.sum() < window:
         return math.nan
-    x, ly = np.log(h[ok]), np.log(y[ok])
-    k = window // 2
-    worst = 0.0
-    for i in range(n):
-        lo = min(max(0, i - k), n - window)
-        xs, ys = x[lo:lo + window], ly[lo:lo + window]
-        c = np.polyfit(xs - x[i], ys, 2)
-        worst = max(worst, abs(ly[i] - c[-1]))
-    return float(worst)
+    return float(np.max(np.abs(np.log(y[ok]) - np.log(smooth_loglog(h[ok], y[ok], window)))))

@@ -31,7 +31,7 @@ from ..model import Coefficients, ContactLaw, contact
 from .cases import Case, reference_radius, spheres
 from .charts import DPI, pyplot
 from .config import Thresholds
-from .metrics import Summary, interp_loglog, relative_error, summarise, trapezoid_weights
+from .metrics import Summary, interp_loglog, relative_error, smooth_loglog, summarise, trapezoid_weights
 from .tables import markdown_table, pct
 
 __all__ = ["DEFAULTS", "variant", "Variant", "Reference", "standard_runs", "reference", "FEPoint",
@@ -130,7 +130,7 @@ def reference(cases: list[Case], th: Thresholds, start_h_over_R: float = 0.0) ->
             y = interp_loglog(h, fine.h, getattr(fine, q))
         if small is not base:
             y = y * interp_loglog(h, small.h, getattr(small, q)) / getattr(base, q)
-        out[q] = y
+        out[q] = smooth_loglog(h, y)
     parts = []
     if fine is not base:
         parts.append(f"mesh density {variant(fine, th).mesh_density:g} ({fine.label})")
