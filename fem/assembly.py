@@ -25,6 +25,11 @@ from .mesh import HemisphereMesh
 ELEMENTS = {"q8r": (skfem.ElementQuadS2, 3), "q4": (skfem.ElementQuad1, 3)}
 
 
+def positive_jacobian(F: np.ndarray) -> bool:
+    """True when every point of the F vector (5, n) has det F_rz > 0 and F_θθ > 0."""
+    return bool(np.all(F[0] * F[3] - F[1] * F[2] > 0) and np.all(F[4] > 0))
+
+
 class Discretisation:
     """Element arrays of one hemisphere mesh: B, weights, dof maps, CSR pattern."""
 

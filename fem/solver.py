@@ -23,7 +23,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..model.material import Material
-from .assembly import Discretisation
+from .assembly import Discretisation, positive_jacobian
 from .contact import RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
 from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
@@ -129,6 +129,62 @@ def work_increment(h0: float, h1: float, F0: float, F1: float) -> float:
     return (F1 * h1 - F0 * h0) / (p + 1.0)
 
 
+def update_active_set(active: np.ndarray, lam: np.ndarray, gap: np.ndarray, gap_tol: float,
+                      log: dict) -> tuple[np.ndarray, bool]:
+    """Primal–dual active-set step over contact nodes ordered from the pole.
+
+    A closed node stays closed while its reaction is compressive, an open one
+    closes when it penetrates (gap < −gap_tol). The contact of a sphere on a
+    flat, a sphere or another sphere is a disc: every node up to the outermost
+    one that wants contact is closed (no holes from transient tensile forces).
+    When the edge node flips in and out (one node of contact resolution), it is
+    kept closed and ``log["frozen"]`` is set: the increment finishes with that
+    set. ``log`` holds ``changes``, ``flips``, ``frozen``, ``seen`` (sets tried)
+    and ``res`` (the residual history). Returns the new set and whether it changed.
+    """
+    wants = np.where(active, lam > 0.0, gap < -gap_tol)
+    new = np.zeros_like(active)
+    if wants.any():
+        new[: np.flatnonzero(wants).max() + 1] = True
+    if np.array_equal(new, active):
+        return active, False
+    log["changes"] += 1
+    key = new.tobytes()
+    flip = key in log["seen"] and np.count_nonzero(new != active) == 1
+    log["flips"] += flip
+    near = bool(log["res"]) and log["res"][-1] < 1e-4
+    if flip and (near or log["flips"] >= 3):
+        new = new | active
+        log["frozen"] = True
+    log["seen"].add(key)
+    return new, not np.array_equal(new, active)
+
+
+def new_active_log() -> dict:
+    """Empty bookkeeping of :func:`update_active_set` for one increment."""
+    return {"changes": 0, "flips": 0, "frozen": False, "seen": set(), "res": []}
+
+
+def plastic_dissipation(disc: Discretisation, material: Material, eps_p_n: np.ndarray,
+                        dgamma: np.ndarray) -> float:
+    """Dissipation of one increment, ∫ σ_f(ε_p,n + Δγ) Δγ dV₀ (backward Euler)."""
+    if not np.isfinite(material.sigma_y):
+        return 0.0
+    return disc.integrate(np.where(dgamma > 0, material.flow_stress(eps_p_n + dgamma) * dgamma, 0.0))
+
+
+def finish_curves(curves: dict) -> dict:
+    """Smoothed contact radii (raw ones kept), mean pressure and integer counters."""
+    curves["a_raw"], curves["a_ref_raw"] = curves["a"], curves["a_ref"]
+    curves["a"] = smooth_contact_radius(curves["h"], curves["a_raw"])
+    curves["a_ref"] = smooth_contact_radius(curves["h"], curves["a_ref_raw"])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        curves["p_m"] = np.where(curves["a"] > 0, curves["F"] / (np.pi * curves["a"] ** 2), 0.0)
+    for k in ("iterations", "active_changes"):
+        curves[k] = curves[k].astype(int)
+    return curves
+
+
 class IndentationSolver:
     """Hemisphere (radius R, material) on a rigid obstacle; call ``run(h_max)``."""
 
@@ -188,17 +244,14 @@ class IndentationSolver:
         disc, mat = self.disc, self.material
         R = self.radius
         Xs = self.X[:, self.surface]
-        res_hist = []
-        seen = set()
-        changes = 0
-        frozen = False
-        flips = 0
+        log = new_active_log()
+        res_hist = log["res"]
         known = None  # (F, real stress update, internal force) at u from the line search
         for it in range(opt.max_iterations):
             t0 = time.perf_counter()
             if known is None:
                 Fv = disc.deformation_gradient(u)
-                if np.any(Fv[0] * Fv[3] - Fv[1] * Fv[2] <= 0) or np.any(Fv[4] <= 0):
+                if not positive_jacobian(Fv):
                     raise IncrementFailed("inverted element (J <= 0)")
                 upd, A = stress_and_tangent(Fv, state, mat)
                 f = disc.internal_force(upd.P)
@@ -210,29 +263,9 @@ class IndentationSolver:
             t2 = time.perf_counter()
             gap, normal, curv = self.obstacle.gap_normal(Xs + self._nodal(u, self.surface))
             lam = np.einsum("ci,ci->i", self._nodal(f, self.surface), normal)
-            if not frozen:
-                wants = np.where(active, lam > 0.0, gap < -1e-12 * R)
-                # the contact of a sphere on a flat or sphere is a disc: close every node up to
-                # the outermost one that wants contact (no holes from transient tensile forces)
-                new_active = np.zeros_like(active)
-                if wants.any():
-                    new_active[: np.flatnonzero(wants).max() + 1] = True
-                key = new_active.tobytes()
-                if not np.array_equal(new_active, active):
-                    changes += 1
-                    flip = key in seen and np.count_nonzero(new_active != active) == 1
-                    flips += flip
-                    near = bool(res_hist) and res_hist[-1] < 1e-4
-                    if flip and (near or flips >= 3):
-                        # the edge node flips in and out (one node of contact resolution):
-                        # keep it closed and finish the increment with that set
-                        new_active = new_active | active
-                        frozen = True
-                    seen.add(key)
-                changed = not np.array_equal(new_active, active)
-                active = new_active
-            else:
-                changed = False
+            changed = False
+            if not log["frozen"]:
+                active, changed = update_active_set(active, lam, gap, 1e-12 * R, log)
             T, cdofs = self._frame(active, normal)
             if not self.obstacle.is_flat:
                 idx = np.flatnonzero(active & ~self.on_axis)
@@ -269,7 +302,8 @@ class IndentationSolver:
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
             if not changed and res <= max(opt.tol, floor) and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
-                return u, upd, active, it, changes, res_hist, f, gap, np.where(active, lam, 0.0), normal
+                return (u, upd, active, it, log["changes"], res_hist, f, gap, np.where(active, lam, 0.0),
+                        normal)
             Kff = K[free][:, free]
             rhs = -r[free] - K[free][:, ~free] @ du_c[~free]
             lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A",
@@ -319,8 +353,7 @@ class IndentationSolver:
         """u + β du with the largest β = 2^-k keeping every Jacobian positive."""
         beta = 1.0
         for _ in range(halvings + 1):
-            Fv = self.disc.deformation_gradient(u + beta * du)
-            if np.all(Fv[0] * Fv[3] - Fv[1] * Fv[2] > 0) and np.all(Fv[4] > 0):
+            if positive_jacobian(self.disc.deformation_gradient(u + beta * du)):
                 return (u + beta * du, base_alpha * beta) if with_alpha else u + beta * du
             beta *= 0.5
         raise IncrementFailed("inverted element (J <= 0) even after step halving")
@@ -375,11 +408,7 @@ class IndentationSolver:
                     break
                 continue
             # ---- commit
-            eps_p_n = state.eps_p
-            dgamma = upd.dgamma
-            diss_inc = self.disc.integrate(
-                np.where(dgamma > 0, self.material.flow_stress(eps_p_n + dgamma) * dgamma, 0.0)
-                if np.isfinite(self.material.sigma_y) else np.zeros_like(dgamma))
+            diss_inc = plastic_dissipation(self.disc, self.material, state.eps_p, upd.dgamma)
             state = PlasticState(upd.cp_inv, upd.eps_p, state.dissipation + diss_inc)
             u_prev, u, dh_prev, active = u, u_new, dh, act
             h = h_new
@@ -415,14 +444,7 @@ class IndentationSolver:
         curves = {k: np.asarray(getattr(hist, k), dtype=float) for k in (
             "h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max", "work_external",
             "energy_elastic", "dissipation", "iterations", "active_changes")}
-        # a: sub-element estimates smoothed over increments; the raw ones are kept
-        curves["a_raw"], curves["a_ref_raw"] = curves["a"], curves["a_ref"]
-        curves["a"] = smooth_contact_radius(curves["h"], curves["a_raw"])
-        curves["a_ref"] = smooth_contact_radius(curves["h"], curves["a_ref_raw"])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            curves["p_m"] = np.where(curves["a"] > 0, curves["F"] / (np.pi * curves["a"] ** 2), 0.0)
-        curves["iterations"] = curves["iterations"].astype(int)
-        curves["active_changes"] = curves["active_changes"].astype(int)
+        finish_curves(curves)  # a: sub-element estimates smoothed over increments
         nsurf = self.surface.size
         prof_r = np.array(hist.profile_r).reshape(-1, nsurf)
         prof_p = np.array(hist.profile_p).reshape(-1, nsurf)

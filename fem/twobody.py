@@ -27,21 +27,42 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..model.material import Material
-from .assembly import Discretisation
-from .contact import contact_edge, smooth_contact_radius, surface_areas
+from .assembly import Discretisation, positive_jacobian
+from .contact import contact_edge, surface_areas
 from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segments import N_COORDS, gap_gradient, gap_hessian
-from .solver import ROUNDOFF, IncrementFailed, RunResult, SolverOptions, work_increment
+from .solver import (
+    ROUNDOFF,
+    IncrementFailed,
+    RunResult,
+    SolverOptions,
+    finish_curves,
+    new_active_log,
+    plastic_dissipation,
+    update_active_set,
+    work_increment,
+)
 
 #: |g| of active nodes at convergence, relative to the smaller radius
 GAP_TOL = 1e-12
+
+
+class Kinematics(NamedTuple):
+    """Contact kinematics of the slave candidates at one displacement (see segments.py)."""
+
+    seg: np.ndarray  # master interval per candidate (n,)
+    coords: np.ndarray  # gap coordinates (10, n)
+    gap: np.ndarray  # (n,)
+    grad: np.ndarray  # ∂g/∂coords (10, n)
+    normal: np.ndarray  # outward master normal (2, n)
 
 
 @dataclass
@@ -104,7 +125,6 @@ class TwoBodySolver:
         self.ctrl_nodes, self.ctrl_rsign = self._control_points()
         # outward normal of the master: up for body 2 (below), down for body 1 (above)
         self.side = 1.0 if self.master.mirror else -1.0
-        self.on_axis = np.isin(self.candidates, self.slave.hmesh.axis)
         fixed = []
         for b in self.bodies:
             fixed += [b.offset + 2 * b.hmesh.equator + 1, b.offset + 2 * b.hmesh.axis]
@@ -127,8 +147,8 @@ class TwoBodySolver:
         rsign = np.where(pos < 0, -1.0, 1.0)
         return arc[np.abs(pos)], rsign
 
-    def _pairs(self, u: np.ndarray):
-        """Master interval of every slave candidate and the 10 gap coordinates per pair."""
+    def _kinematics(self, u: np.ndarray) -> Kinematics:
+        """Master interval, gap coordinates, gap, ∂g and normal of every slave candidate at u."""
         xs = self.slave.positions(u, self.candidates)
         xm = self.master.positions(u, self.master_arc)
         d2 = (xs[0][:, None] - xm[0][None]) ** 2 + (xs[1][:, None] - xm[1][None]) ** 2
@@ -136,20 +156,20 @@ class TwoBodySolver:
         last = self.ctrl_nodes.shape[1] - 1
         best, best_excess = None, None
         for seg in (np.clip(k - 1, 0, last), np.clip(k, 0, last)):  # the interval holding t
-            coords = self._coords(u, seg)
-            t = gap_gradient(coords, self.side)[2]
+            coords = self._coords(xs, u, seg)
+            gap, grad, t, normal = gap_gradient(coords, self.side)
+            here = Kinematics(seg, coords, gap, grad, normal)
             excess = np.maximum(np.maximum(-t, t - 1.0), 0.0)
             if best is None:
-                best, best_excess = seg, excess
+                best, best_excess = here, excess
             else:
                 better = excess < best_excess
-                best = np.where(better, seg, best)
+                best = Kinematics(*(np.where(better, new, old) for new, old in zip(here, best, strict=True)))
                 best_excess = np.minimum(excess, best_excess)
-        return best, self._coords(u, best)
+        return best
 
-    def _coords(self, u, seg):
-        """(10, n): slave candidate positions and the control points of intervals ``seg``."""
-        xs = self.slave.positions(u, self.candidates)
+    def _coords(self, xs, u, seg):
+        """(10, n): slave positions ``xs`` and the control points of intervals ``seg``."""
         nodes, rsign = self.ctrl_nodes[:, seg], self.ctrl_rsign[:, seg]
         P = self.master.positions(u, nodes.ravel()).reshape(2, 4, -1)
         P[0] *= rsign
@@ -167,24 +187,27 @@ class TwoBodySolver:
                                 for b, rs in zip(bodies, rsigns, strict=True)])
         return dofs, signs
 
-    def _contact(self, u: np.ndarray, active: np.ndarray, lam: np.ndarray, hessian: bool):
-        """Gaps of all candidates; G (n_active × n_dofs), Gᵀλ and −Σ λ ∂²g for the active set."""
-        seg, coords = self._pairs(u)
-        gap, grad, _, normal = gap_gradient(coords, self.side)
+    def _constraints(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
+        """G = ∂g/∂u of the active nodes (n_active × n_dofs) and Gᵀλ."""
         rows = np.flatnonzero(active)
-        dofs, signs = self._dofs_and_signs(seg, rows)
-        gl = grad[:, rows] * signs
+        dofs, signs = self._dofs_and_signs(kin.seg, rows)
+        gl = kin.grad[:, rows] * signs
         G = sp.csr_matrix((gl.T.ravel(), (np.repeat(np.arange(rows.size), N_COORDS), dofs.T.ravel())),
                           shape=(rows.size, self.n_dofs))
         Gt_lam = np.bincount(dofs.ravel(), weights=(gl * lam[rows]).ravel(), minlength=self.n_dofs)
-        Kc = None
-        if hessian and rows.size:
-            H = gap_hessian(coords[:, rows], self.side) * signs[:, None, :] * signs[None, :, :]
-            vals = -(H * lam[rows]).ravel()
-            r_idx = np.repeat(dofs[:, None, :], N_COORDS, axis=1).ravel()
-            c_idx = np.repeat(dofs[None, :, :], N_COORDS, axis=0).ravel()
-            Kc = sp.csr_matrix((vals, (r_idx, c_idx)), shape=(self.n_dofs,) * 2)
-        return gap, normal, G, Gt_lam, Kc
+        return G, Gt_lam
+
+    def _contact_stiffness(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
+        """−Σ λ_i ∂²g_i over the active nodes (n_dofs × n_dofs), or None without contact."""
+        rows = np.flatnonzero(active)
+        if not rows.size:
+            return None
+        dofs, signs = self._dofs_and_signs(kin.seg, rows)
+        H = gap_hessian(kin.coords[:, rows], self.side) * signs[:, None, :] * signs[None, :, :]
+        vals = -(H * lam[rows]).ravel()
+        r_idx = np.repeat(dofs[:, None, :], N_COORDS, axis=1).ravel()
+        c_idx = np.repeat(dofs[None, :, :], N_COORDS, axis=0).ravel()
+        return sp.csr_matrix((vals, (r_idx, c_idx)), shape=(self.n_dofs,) * 2)
 
     # ------------------------------------------------------------------ bodies
     def _stress(self, u, states, known=None):
@@ -193,7 +216,7 @@ class TwoBodySolver:
         for i, (b, st) in enumerate(zip(self.bodies, states, strict=True)):
             if known is None:
                 Fv = b.disc.deformation_gradient(b.local(u))
-                if np.any(Fv[0] * Fv[3] - Fv[1] * Fv[2] <= 0) or np.any(Fv[4] <= 0):
+                if not positive_jacobian(Fv):
                     raise IncrementFailed(f"inverted element (J <= 0) in body {i + 1}")
                 upd, A = stress_and_tangent(Fv, st, b.material)
                 fb = b.disc.internal_force(upd.P)
@@ -205,38 +228,15 @@ class TwoBodySolver:
         return out, f
 
     def _jacobians_positive(self, u) -> bool:
-        for b in self.bodies:
-            Fv = b.disc.deformation_gradient(b.local(u))
-            if not (np.all(Fv[0] * Fv[3] - Fv[1] * Fv[2] > 0) and np.all(Fv[4] > 0)):
-                return False
-        return True
+        return all(positive_jacobian(b.disc.deformation_gradient(b.local(u))) for b in self.bodies)
 
     # ------------------------------------------------------------------ one Newton solve
-    def _update_active(self, active, lam, gap, log):
-        """Primal–dual active set kept a disc, with the edge-flip freeze of the one-body solver."""
-        wants = np.where(active, lam > 0.0, gap < -GAP_TOL * self.R)
-        new = np.zeros_like(active)
-        if wants.any():
-            new[: np.flatnonzero(wants).max() + 1] = True
-        if np.array_equal(new, active):
-            return active, False
-        log["changes"] += 1
-        key = new.tobytes()
-        flip = key in log["seen"] and np.count_nonzero(new != active) == 1
-        log["flips"] += flip
-        near = bool(log["res"]) and log["res"][-1] < 1e-4
-        if flip and (near or log["flips"] >= 3):
-            new = new | active
-            log["frozen"] = True
-        log["seen"].add(key)
-        return new, not np.array_equal(new, active)
-
     def _newton(self, u, states, active, lam):
         opt = self.options
         nd, free = self.n_dofs, self.free
         scale = max(b.material.E * b.radius for b in self.bodies)  # λ = scale · μ
-        log = {"changes": 0, "flips": 0, "frozen": False, "seen": set(), "res": []}
-        known = None
+        log = new_active_log()
+        known, kin = None, None  # from the line search: stresses and contact kinematics at u
         for it in range(opt.max_iterations):
             t0 = time.perf_counter()
             per_body, f = self._stress(u, states, known)
@@ -244,26 +244,25 @@ class TwoBodySolver:
             K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body,
                                                                             strict=True)], format="csr")
             t2 = time.perf_counter()
-            gap, normal, G, Gt_lam, Kc = self._contact(u, active, lam, hessian=False)
+            kin = kin or self._kinematics(u)
             changed = False
             if not log["frozen"]:
-                active, changed = self._update_active(active, lam, gap, log)
+                active, changed = update_active_set(active, lam, kin.gap, GAP_TOL * self.R, log)
                 lam = np.where(active, lam, 0.0)
-                if changed:
-                    gap, normal, G, Gt_lam, Kc = self._contact(u, active, lam, hessian=False)
+            G, Gt_lam = self._constraints(kin, active, lam)
             r = f - Gt_lam
             ref = max(np.abs(r[~free]).max(), np.abs(Gt_lam).max(), 1e-300)
             res = float(np.abs(r[free]).max()) / ref
             floor = ROUNDOFF * max(b.material.E for b in self.bodies) * self.R**2 / ref
-            gap_err = float(np.abs(gap[active]).max(initial=0.0))
+            gap_err = float(np.abs(kin.gap[active]).max(initial=0.0))
             log["res"].append(res)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
             self.timers["constitutive"] += t1 - t0
             self.timers["assembly"] += t2 - t1
             if not changed and res <= max(opt.tol, floor) and gap_err <= GAP_TOL * self.R:
-                return u, per_body, f, active, lam, gap, normal, it, log
-            _, _, G, _, Kc = self._contact(u, active, lam, hessian=True)
+                return u, per_body, f, active, lam, kin.gap, kin.normal, it, log
+            Kc = self._contact_stiffness(kin, active, lam)
             t3 = time.perf_counter()
             self.timers["contact"] += t3 - t2
             if Kc is not None:
@@ -272,19 +271,23 @@ class TwoBodySolver:
             n_act = G.shape[0]
             system = sp.bmat([[K[free][:, free], -scale * Gf.T],
                               [-scale * Gf, sp.csr_matrix((n_act, n_act))]], format="csc")
-            rhs = np.concatenate([-f[free], scale * gap[active]])
+            rhs = np.concatenate([-f[free], scale * kin.gap[active]])
             sol = spla.splu(system, permc_spec="COLAMD").solve(rhs)
             du = np.zeros(nd)
             du[free] = sol[:free.sum()]
             lam = np.zeros_like(lam)
             lam[active] = scale * sol[free.sum():]
-            u, known = self._line_search(u, du, f, states, active, lam)
+            u, known, kin = self._line_search(u, du, f, kin, states, active, lam)
             self.timers["solve"] += time.perf_counter() - t3
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {log['res'][-1]:.2e})")
 
-    def _line_search(self, u, du, f0, states, active, lam, max_steps: int = 4):
-        """Energy line search on the Lagrangian with the new multipliers fixed (cf. solver.py)."""
+    def _line_search(self, u, du, f0, kin0, states, active, lam, max_steps: int = 4):
+        """Energy line search on the Lagrangian with the new multipliers fixed (cf. solver.py).
+
+        Returns the new u and, when the accepted step was evaluated, its per-body
+        (F, real stress update, internal force) and contact kinematics (else None, None).
+        """
         free = self.free
         duf = du[free]
 
@@ -296,8 +299,9 @@ class TwoBodySolver:
                 fb = b.disc.internal_force(real.P)
                 f[b.offset:b.offset + b.n_dofs] = fb
                 known.append((Fv, real, fb))
-            Gt_lam = self._contact(trial, active, lam, hessian=False)[3]
-            return float(np.dot(duf, (f - Gt_lam)[free])), known
+            kin = self._kinematics(trial)
+            Gt_lam = self._constraints(kin, active, lam)[1]
+            return float(np.dot(duf, (f - Gt_lam)[free])), known, kin
 
         beta = 1.0
         while not self._jacobians_positive(u + beta * du):
@@ -306,21 +310,21 @@ class TwoBodySolver:
                 raise IncrementFailed("inverted element (J <= 0) even after step halving")
         du = beta * du
         if not self.options.line_search:
-            return u + du, None
-        s0 = float(np.dot(duf, (f0 - self._contact(u, active, lam, hessian=False)[3])[free]))
+            return u + du, None, None
+        s0 = float(np.dot(duf, (f0 - self._constraints(kin0, active, lam)[1])[free]))
         if s0 >= 0.0:
-            return u + du, None
+            return u + du, None, None
         alpha, lo, s_lo = 1.0, 0.0, s0
         for _ in range(max_steps):
             trial = u + alpha * du
-            s_a, known = slope(trial)
+            s_a, known, kin = slope(trial)
             if abs(s_a) <= 0.5 * abs(s0) or s_a < 0.0:
-                return trial, known
+                return trial, known, kin
             alpha = float(np.clip(lo + (alpha - lo) * s_lo / (s_lo - s_a), 0.1 * alpha, alpha))
-        return trial, known
+        return trial, known, kin
 
     # ------------------------------------------------------------------ the incremental run
-    def _predictor(self, h_new, dh):
+    def _predictor(self, dh):
         """Rigid translations towards each other by dh/2 in total, split as Hertz's h₁/h₂."""
         e1, e2 = (b.material.E_prime for b in self.bodies)
         w1 = e2 / (e1 + e2)
@@ -384,7 +388,7 @@ class TwoBodySolver:
             a_last = rec["a_nodes"][-1] if rec["a_nodes"] else 0.0
             dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
             h_new = h + dh
-            u_pred = self._predictor(h_new, dh) if u_prev is None else u + (dh / dh_prev) * (u - u_prev)
+            u_pred = self._predictor(dh) if u_prev is None else u + (dh / dh_prev) * (u - u_prev)
             u_pred = self._apply_bc(u_pred, h_new)
             try:
                 u_new, per_body, f, act, lam_new, gap, normal, its, log = self._newton(
@@ -398,14 +402,10 @@ class TwoBodySolver:
                     break
                 continue
             # ---- commit
-            new_states, diss = [], []
-            for b, st, (_, upd, _) in zip(self.bodies, states, per_body, strict=True):
-                dg = upd.dgamma
-                inc = b.disc.integrate(np.where(dg > 0, b.material.flow_stress(st.eps_p + dg) * dg, 0.0)
-                                       if np.isfinite(b.material.sigma_y) else np.zeros_like(dg))
-                new_states.append(PlasticState(upd.cp_inv, upd.eps_p, st.dissipation + inc))
-                diss.append(st.dissipation + inc)
-            states = new_states
+            states = [PlasticState(upd.cp_inv, upd.eps_p, st.dissipation
+                                   + plastic_dissipation(b.disc, b.material, st.eps_p, upd.dgamma))
+                      for b, st, (_, upd, _) in zip(self.bodies, states, per_body, strict=True)]
+            diss = [st.dissipation for st in states]
             u_prev, u, dh_prev, active, lam = u, u_new, dh, act, lam_new
             h = h_new
             b1, b2 = self.bodies
@@ -444,14 +444,7 @@ class TwoBodySolver:
                             h_max, time.perf_counter() - t_start)
 
     def _result(self, rec, residuals, prof_r, prof_p, prof_g, status, reason, u, states, h_max, wall):
-        curves = {k: np.asarray(v, dtype=float) for k, v in rec.items()}
-        curves["a_raw"], curves["a_ref_raw"] = curves["a"], curves["a_ref"]
-        curves["a"] = smooth_contact_radius(curves["h"], curves["a_raw"])
-        curves["a_ref"] = smooth_contact_radius(curves["h"], curves["a_ref_raw"])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            curves["p_m"] = np.where(curves["a"] > 0, curves["F"] / (np.pi * curves["a"] ** 2), 0.0)
-        for k in ("iterations", "active_changes"):
-            curves[k] = curves[k].astype(int)
+        curves = finish_curves({k: np.asarray(v, dtype=float) for k, v in rec.items()})
         n = self.candidates.size
         timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
                    "increments": int(curves["h"].size), "newton_iterations": int(curves["iterations"].sum()),
