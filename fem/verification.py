@@ -62,10 +62,21 @@ def _run(kind: str, E_over_sy: float, h_max: float, density: float = 1.0, elemen
            "residuals": [list(map(float, r)) for r in res.residuals],
            "n_dofs": int(solver.disc.n_dofs), "rejected": len(solver.rejected)}
     if log_dir:  # each run saves itself: nothing finished is lost if the caller fails
-        tmp = Path(log_dir) / f".run_{name}.json.tmp"
-        tmp.write_text(json.dumps(out))
-        os.replace(tmp, Path(log_dir) / f"run_{name}.json")
+        save_run(log_dir, f"run_{name}.json", out)
     return out
+
+
+def save_run(outdir, filename: str, run: dict) -> None:
+    """Write one run's JSON atomically to ``outdir/filename`` (never half-written)."""
+    tmp = Path(outdir) / f".{filename}.tmp"
+    tmp.write_text(json.dumps(run))
+    os.replace(tmp, Path(outdir) / filename)
+
+
+def saved_runs(outdir, names, prefix: str) -> dict:
+    """Runs ``outdir/<prefix><name>.json`` already on disk (``--reuse``), by name."""
+    paths = {n: Path(outdir) / f"{prefix}{n}.json" for n in names}
+    return {n: json.loads(p.read_text()) for n, p in paths.items() if p.exists()}
 
 
 def _at(run: dict, key: str, h: float) -> float:
@@ -349,12 +360,7 @@ def main(argv: list[str] | None = None) -> int:
     order = sorted(cases, key=lambda k: cases[k]["h_max"] * cases[k].get("density", 1.0) ** 2)
     from tqdm import tqdm
 
-    runs = {}
-    if args.reuse:
-        for k in order:
-            f = outdir / f"run_{k}.json"
-            if f.exists():
-                runs[k] = json.loads(f.read_text())
+    runs = saved_runs(outdir, order, "run_") if args.reuse else {}
     todo = [k for k in order if k not in runs]
     failed: dict[str, str] = {}
     with ProcessPoolExecutor(max_workers=args.workers) as pool:

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -28,6 +27,7 @@ import numpy as np
 
 from ..model.material import Material
 from .io import run_indentation
+from .verification import save_run, saved_runs
 
 NU = 0.3
 EPP = Material(E=200.0, nu=NU, sigma_y=1.0, K=0.0, n=1.0)
@@ -57,9 +57,7 @@ def _run(name: str, kwargs: dict, outdir: Path) -> dict:
            "status": res.status, "reason": res.reason, "scene": res.inputs["scene"],
            "timings": {k: float(v) for k, v in res.timings.items()},
            "n_dofs": int(res.inputs["n_dofs"]), "wall_s": time.perf_counter() - t0}
-    tmp = outdir / f".pair_{name}.json.tmp"
-    tmp.write_text(json.dumps(out))
-    os.replace(tmp, outdir / f"pair_{name}.json")
+    save_run(outdir, f"pair_{name}.json", out)
     return out
 
 
@@ -200,12 +198,7 @@ def main(argv: list[str] | None = None) -> int:
     outdir.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     cases = _cases(args.quick)
-    runs = {}
-    if args.reuse:
-        for name in cases:
-            path = outdir / f"pair_{name}.json"
-            if path.exists():
-                runs[name] = json.loads(path.read_text())
+    runs = saved_runs(outdir, cases, "pair_") if args.reuse else {}
     todo = [n for n in cases if n not in runs]
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         futures = {pool.submit(_run, n, cases[n], outdir): n for n in todo}
