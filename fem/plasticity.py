@@ -100,9 +100,12 @@ def solve_plastic_multiplier(q_tr, eps_p_n, material: Material, mu: float, tol=1
     """Δγ ≥ 0 with q_tr − 3μΔγ − σ_f(ε_p,n + Δγ) = 0, vectorised (bracketed Newton).
 
     The residual is strictly decreasing in Δγ; the root lies in [0, q_tr/(3μ)].
-    Converged where |residual| ≤ tol σ_Y or where the bracket has shrunk to the
-    roundoff of ε_p (hardening exponents n < 1 have an unbounded slope at
-    ε_p → 0, where σ_f cannot be resolved to tol in double precision).
+    Perfect plasticity has a closed form and Ludwik hardening with n < 1 (slope
+    unbounded at ε_p → 0) is solved in y = ε_p^n (:func:`_multiplier_power`).
+    Here Newton falls back to bisection when it leaves the bracket or stalls
+    (the material's slope is floored at tiny ε_p and one-sided at table kinks);
+    a point is converged where |residual| ≤ tol σ_Y or its bracket has shrunk to
+    the roundoff of ε_p.
     """
     q_tr = np.asarray(q_tr, dtype=float)
     if not material.is_tabulated and material.K == 0.0:
