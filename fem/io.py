@@ -50,6 +50,7 @@ __all__ = [
     "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "SCENES", "Run", "check_inputs", "choose_scene",
     "run_indentation",
     "write_run", "write_run_group", "read_run", "run_from_group", "provenance",
+    "material_from_description",
 ]
 
 SCHEMA = "spherecontact.fem.run"
@@ -517,12 +518,14 @@ def write_run(path, result: RunResult, extra_provenance: dict | None = None) -> 
 
 # ============================================================================ reading
 def material_from_description(m: dict) -> Material:
-    """Inverse of ``Material.describe()``."""
+    """Inverse of ``Material.describe()``: E = inf is rigid; missing plastic keys are elastic."""
+    E, nu = float(m["E"]), float(m.get("nu", 0.3))
+    if math.isinf(E):
+        return Material.rigid(nu)
     if "eps_table" in m:
-        return Material.from_table(m["E"], m["nu"], m["eps_table"], m["sigma_table"])
-    if math.isinf(m["E"]):
-        return Material.rigid()
-    return Material(E=m["E"], nu=m["nu"], sigma_y=m["sigma_y"], K=m["K"], n=m["n"])
+        return Material.from_table(E, nu, m["eps_table"], m["sigma_table"])
+    return Material(E=E, nu=nu, sigma_y=float(m.get("sigma_y", math.inf)), K=float(m.get("K", 0.0)),
+                    n=float(m.get("n", 1.0)))
 
 
 @dataclass(frozen=True, eq=False)

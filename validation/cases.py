@@ -23,12 +23,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fem.io import material_from_description
 from ..model import Material, Sphere
 
 __all__ = [
     "CLASSES",
     "Case",
-    "material_from_dict",
     "scene_of",
     "spheres",
     "reference_radius",
@@ -100,18 +100,6 @@ class Case:
 
 
 # ============================================================================ materials and scenes
-def material_from_dict(d: dict) -> Material:
-    """Material from a run's input dict (``E, nu, sigma_y, K, n`` or a flow table; E = inf rigid)."""
-    E = float(d["E"])
-    nu = float(d.get("nu", 0.3))
-    if math.isinf(E):
-        return Material.rigid(nu)
-    if "eps_table" in d:
-        return Material.from_table(E, nu, d["eps_table"], d["sigma_table"])
-    return Material(E=E, nu=nu, sigma_y=float(d.get("sigma_y", math.inf)),
-                    K=float(d.get("K", 0.0)), n=float(d.get("n", 1.0)))
-
-
 #: the FE run's own scene names (``run.inputs["scene"]``) → scene of this module
 FE_SCENES = {"rigid_flat": "flat", "rigid_sphere": "rigid_sphere", "two_body": "two_body",
              "equal_pair_symmetry": "two_body"}
@@ -133,11 +121,11 @@ def scene_of(params: dict, inputs: dict) -> str:
 
 def spheres(case: Case) -> tuple[Sphere, Sphere]:
     """The sphere pair of the FE scene (body 1 is the FE hemisphere of ``radius``)."""
-    s1 = Sphere(float(case.inputs["radius"]), material_from_dict(case.inputs["material"]))
+    s1 = Sphere(float(case.inputs["radius"]), material_from_description(case.inputs["material"]))
     scene = case.scene
     if scene == "two_body":
         m2 = case.inputs.get("material2", case.inputs["material"])
-        return s1, Sphere(float(case.inputs.get("radius2", s1.radius)), material_from_dict(m2))
+        return s1, Sphere(float(case.inputs.get("radius2", s1.radius)), material_from_description(m2))
     if scene == "rigid_sphere":
         R2 = case.inputs.get("indenter_radius", math.inf)
         if not math.isfinite(float(R2)):
