@@ -162,15 +162,7 @@ def penalty_section(cases: list[Case], th: Thresholds, out: Path):
         R = reference_radius(p)
         for k, e in enumerate((eF, ea)):
             ax[k].plot(p.h / R, 100 * e, color=f"C{i}", label=f"penalty {v.penalty:g}")
-    for k, q in enumerate(("F", "a")):
-        ax[k].set_xlabel("h / R")
-        ax[k].set_ylabel(f"{q} relative to exact contact %")
-        ax[k].axhline(0, color="0.5", lw=0.6)
-    ax[0].legend(fontsize=7)
-    fig.tight_layout()
-    path = out / "stability_penalty.png"
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    path = _save_error_chart(plt, fig, ax, "relative to exact contact", out / "stability_penalty.png")
     table = markdown_table(["penalty (relative stiffness)", "run", "F max (rms) % vs exact",
                             "a max (rms) % vs exact", "max penetration / R",
                             "Newton iterations (penalty / exact)", "wall s (penalty / exact)",
@@ -178,6 +170,19 @@ def penalty_section(cases: list[Case], th: Thresholds, out: Path):
     text = ("Largest difference from the exact (active-set) contact over the run: " + "; ".join(notes)
             + ".") if notes else ""
     return text + "\n\n" + table, path
+
+
+def _save_error_chart(plt, fig, ax, against: str, path: Path) -> Path:
+    """Label the F and a error panels against h/R ("<q> <against> %"), save and close."""
+    for k, q in enumerate(("F", "a")):
+        ax[k].set_xlabel("h / R")
+        ax[k].set_ylabel(f"{q} {against} %")
+        ax[k].axhline(0, color="0.5", lw=0.6)
+    ax[0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
 
 
 # ============================================================================ increments
@@ -208,15 +213,7 @@ def increment_section(cases: list[Case], ref: Reference | None, th: Thresholds, 
                      f"{pct(out_q['a'].max, 2)} ({pct(out_q['a'].rms, 2)})",
                      pct(energy_balance(c), 2), _status(c)])
         worst.append((v.strain_increment, out_q["F"], out_q["a"], energy_balance(c), c))
-    for k, q in enumerate(("F", "a")):
-        ax[k].set_xlabel("h / R")
-        ax[k].set_ylabel(f"{q} relative to best FE estimate %")
-        ax[k].axhline(0, color="0.5", lw=0.6)
-    ax[0].legend(fontsize=7)
-    fig.tight_layout()
-    path = out / "stability_increments.png"
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
+    path = _save_error_chart(plt, fig, ax, "relative to best FE estimate", out / "stability_increments.png")
     table = markdown_table(["strain increment Δε", "run", "increments", "Newton iterations",
                             "rejected increments", "wall s", "F max (rms) %", "a max (rms) %",
                             "energy balance miss %", "status"], rows)
