@@ -28,6 +28,8 @@ SIZE_POLE = 0.003  # within _POLE_DIST of the contact pole
 SIZE_ARC = 0.02  # along the whole arc
 SIZE_BULK = 0.10  # far from the arc
 _POLE_DIST = 0.07  # radius of the finest zone around the pole
+#: node order that reverses a quad's orientation, by nodes per element (corners, then midsides)
+REVERSED = {4: [0, 3, 2, 1], 8: [0, 3, 2, 1, 7, 6, 5, 4]}
 
 
 @dataclass(frozen=True)
@@ -149,7 +151,7 @@ def _gmsh_quad8(radius: float, density: float, linear: bool,
     area = 0.5 * np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y, axis=0)
     flip = area < 0
     if np.any(flip):
-        order = [0, 3, 2, 1] if linear else [0, 3, 2, 1, 7, 6, 5, 4]
+        order = REVERSED[nper]
         t[:, flip] = t[order][:, flip]
     return X, t
 

@@ -36,7 +36,7 @@ import scipy.sparse.linalg as spla
 from ..model.material import Material
 from .assembly import Discretisation, positive_jacobian
 from .contact import contact_edge, surface_areas
-from .mesh import build_mesh
+from .mesh import REVERSED, build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segments import N_COORDS, gap_gradient, gap_hessian
 from .solver import (
@@ -469,7 +469,7 @@ class TwoBodySolver:
         u2 = b2.local(u).reshape(-1, 2) * np.array([1.0, -1.0])
         c1 = b1.disc.basis.element_dofs.T
         c2 = b2.disc.basis.element_dofs.T
-        flip = [0, 3, 2, 1, 7, 6, 5, 4] if c2.shape[1] == 8 else [0, 3, 2, 1]
+        flip = REVERSED[c2.shape[1]]
         return {"X": np.concatenate([b1.hmesh.X, X2], axis=1),
                 "u": np.concatenate([b1.local(u), u2.ravel()]),
                 "cells": np.concatenate([c1, c2[:, flip] + n1]),
