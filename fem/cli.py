@@ -106,11 +106,11 @@ def material2_from_args(args: argparse.Namespace, material: Material) -> Materia
 
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
     """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
-    --strain-increment, --max-wall-s and --no-line-search."""
+    --strain-increment, --max-wall-s, --no-line-search and --penalty."""
     return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
                          max_iterations=args.max_iterations, tol=args.tol,
                          strain_increment=args.strain_increment, max_wall_s=args.max_wall_s,
-                         line_search=not args.no_line_search)
+                         line_search=not args.no_line_search, penalty=args.penalty)
 
 
 def _check_output(out) -> Path:
@@ -256,6 +256,9 @@ def _add_numerics(add) -> None:
              "status 'stopped' (default inf: no limit)")
     add(grp, "--no-line-search", action="store_true",
         help="full Newton steps (only the J > 0 guard); the default uses an energy line search")
+    add(grp, "--penalty", type=float, default=None,
+        help="penalty contact with stiffness penalty * E / (pole element length), > 0, rigid "
+             "partner only; the default is exact contact (Lagrange multipliers)")
 
 
 def _add_output(add) -> None:

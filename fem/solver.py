@@ -8,7 +8,10 @@ meets a rigid flat or rigid sphere in frictionless contact (``contact.py``).
 Each increment: secant predictor, then Newton on the free dofs with the exact
 tangent (material ∂P/∂F by complex step, plus the rigid sphere's curvature
 term), the contact active set updated in the same loop (primal–dual active
-set: release on tensile reaction, close on penetration). Increments grow after
+set: release on tensile reaction, close on penetration). With
+``SolverOptions.penalty`` the contact is a penalty instead: every penetrating
+node carries k_N A_i (−g_i) along the obstacle normal (Wriggers 2006, §5.2),
+with no constrained dof; it exists to show what the exact method avoids. Increments grow after
 easy steps and are cut back on divergence; below ``dh_min`` the run stops with
 the converged part kept and flagged.
 """
@@ -50,6 +53,14 @@ class SolverOptions:
     strain_increment: float = 0.005  # dh ≤ strain_increment · a: bounds the strain per step
     max_wall_s: float = float("inf")  # stop (status "stopped", converged part kept) after this
     line_search: bool = True  # energy line search (off: full Newton steps, J > 0 guard only)
+    #: None: exact contact (Lagrange multipliers). A number: penalty contact with stiffness
+    #: k_N = penalty · E / ℓ per unit reference area, ℓ the length of the pole's surface element
+    penalty: float | None = None
+
+    def as_inputs(self) -> dict:
+        """The options as stored with a run; None values are left out (HDF5 attributes have no
+        None, and a missing key reads back as the default)."""
+        return {k: v for k, v in vars(self).items() if v is not None}
 
     def validate(self) -> None:
         for name in ("dh_first", "dh_max", "dh_min", "tol", "strain_increment"):
@@ -64,6 +75,10 @@ class SolverOptions:
             raise ValueError(f"growth must be >= 1, got {self.growth!r}")
         if not (isinstance(self.max_iterations, int) and 2 <= self.max_iterations <= 200):
             raise ValueError(f"max_iterations must be an integer in [2, 200], got {self.max_iterations!r}")
+        if self.penalty is not None and not (isinstance(self.penalty, (int, float))
+                                             and np.isfinite(self.penalty) and self.penalty > 0):
+            raise ValueError(f"penalty must be None (exact contact) or a finite number > 0, "
+                             f"got {self.penalty!r}")
 
 
 @dataclass
@@ -210,11 +225,44 @@ class IndentationSolver:
         self.n_points = self.disc.n_elements * self.disc.n_qp
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
         self._nd = nd
+        self.k_penalty = None
+        if self.options.penalty is not None:
+            x_arc = self.X[:, self.arc]
+            pole_edge = float(np.hypot(*(x_arc[:, 2] - x_arc[:, 0])))
+            self.k_penalty = self.options.penalty * material.E / pole_edge
+            self.area0 = surface_areas(x_arc)[:-1]
 
     @staticmethod
     def _nodal(v: np.ndarray, nodes: np.ndarray) -> np.ndarray:
         """(2, n) r and z components of an interleaved nodal vector at ``nodes``."""
         return np.stack([v[2 * nodes], v[2 * nodes + 1]])
+
+    # ------------------------------------------------------------------ penalty contact
+    def _penalty_force(self, u: np.ndarray):
+        """Penalty contact at u: gap, normal, curvature, penetrating nodes, nodal force
+        magnitudes p_i = k_N A_i (−g_i) and the assembled contact force vector."""
+        gap, normal, curv = self.obstacle.gap_normal(self.X[:, self.surface] + self._nodal(u, self.surface))
+        pen = gap < 0.0
+        p = np.where(pen, self.k_penalty * self.area0 * -gap, 0.0)
+        fc = np.zeros(self._nd)
+        fc[2 * self.surface] = p * normal[0]
+        fc[2 * self.surface + 1] = p * normal[1]
+        return gap, normal, curv, pen, p, fc
+
+    def _penalty_tangent(self, gap, normal, curv, pen) -> sp.csr_matrix:
+        """∂(−f_c)/∂u = k_N A [n nᵀ + g κ (I − n nᵀ)] at the penetrating nodes (κ: 1/|x − c|)."""
+        idx = np.flatnonzero(pen)
+        nodes = self.surface[idx]
+        kA = self.k_penalty * self.area0[idx]
+        n, gk = normal[:, idx], gap[idx] * curv[idx]
+        rows, cols, vals = [], [], []
+        for i in range(2):
+            for j in range(2):
+                rows.append(2 * nodes + i)
+                cols.append(2 * nodes + j)
+                vals.append(kA * (n[i] * n[j] + gk * ((i == j) - n[i] * n[j])))
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                             shape=(self._nd, self._nd))
 
     # ------------------------------------------------------------------ one Newton solve
     def _frame(self, active: np.ndarray, normal: np.ndarray):
@@ -239,6 +287,35 @@ class IndentationSolver:
         cdofs = np.concatenate([2 * rn, 2 * on_axis_nodes + 1])
         return T, cdofs
 
+    def _exact_contact(self, f, K, gap, normal, curv, active, log):
+        """Lagrange-multiplier contact: reactions, active-set update, nodal frame, and the
+        rotated tangent, residual and prescribed normal displacements of the constrained dofs."""
+        lam = np.einsum("ci,ci->i", self._nodal(f, self.surface), normal)
+        changed = False
+        if not log["frozen"]:
+            active, changed = update_active_set(active, lam, gap, 1e-12 * self.radius, log)
+        T, cdofs = self._frame(active, normal)
+        if not self.obstacle.is_flat:
+            idx = np.flatnonzero(active & ~self.on_axis)
+            nodes = self.surface[idx]
+            k = lam[idx] * curv[idx]
+            n = normal[:, idx]
+            tt = np.stack([n[1], -n[0]])
+            blk = [(0, 0, tt[0] * tt[0]), (0, 1, tt[0] * tt[1]), (1, 0, tt[1] * tt[0]),
+                   (1, 1, tt[1] * tt[1])]
+            rows = np.concatenate([2 * nodes + i for i, _, _ in blk])
+            cols = np.concatenate([2 * nodes + j for _, j, _ in blk])
+            vals = np.concatenate([-k * v for _, _, v in blk])
+            K = K + sp.csr_matrix((vals, (rows, cols)), shape=K.shape)
+            K = (T.T @ K @ T).tocsr()
+            r = T.T @ f
+        else:
+            r = f
+        du_c = np.zeros(self._nd)
+        du_c[cdofs] = -gap[active] if self.obstacle.is_flat else np.concatenate(
+            [-gap[active & ~self.on_axis], -gap[active & self.on_axis]])
+        return lam, changed, active, T, cdofs, K, r, du_c
+
     def _newton(self, u: np.ndarray, h: float, state: PlasticState, active: np.ndarray):
         opt = self.options
         disc, mat = self.disc, self.material
@@ -261,34 +338,22 @@ class IndentationSolver:
             t1 = time.perf_counter()
             K = disc.tangent(A)
             t2 = time.perf_counter()
-            gap, normal, curv = self.obstacle.gap_normal(Xs + self._nodal(u, self.surface))
-            lam = np.einsum("ci,ci->i", self._nodal(f, self.surface), normal)
-            changed = False
-            if not log["frozen"]:
-                active, changed = update_active_set(active, lam, gap, 1e-12 * R, log)
-            T, cdofs = self._frame(active, normal)
-            if not self.obstacle.is_flat:
-                idx = np.flatnonzero(active & ~self.on_axis)
-                nodes = self.surface[idx]
-                k = lam[idx] * curv[idx]
-                n = normal[:, idx]
-                tt = np.stack([n[1], -n[0]])
-                blk = [(0, 0, tt[0] * tt[0]), (0, 1, tt[0] * tt[1]), (1, 0, tt[1] * tt[0]),
-                       (1, 1, tt[1] * tt[1])]
-                rows = np.concatenate([2 * nodes + i for i, _, _ in blk])
-                cols = np.concatenate([2 * nodes + j for _, j, _ in blk])
-                vals = np.concatenate([-k * v for _, _, v in blk])
-                K = K + sp.csr_matrix((vals, (rows, cols)), shape=K.shape)
-                K = (T.T @ K @ T).tocsr()
-                r = T.T @ f
+            if self.k_penalty is not None:
+                gap, normal, curv, pen, p, fc = self._penalty_force(u)
+                changed = not np.array_equal(pen, active)
+                active = pen
+                K = K + self._penalty_tangent(gap, normal, curv, pen)
+                r, T, cdofs = f - fc, None, np.zeros(0, dtype=int)
+                lam = p
+                du_c = np.zeros(self._nd)
+                log["changes"] += changed
             else:
-                r = f
+                gap, normal, curv = self.obstacle.gap_normal(Xs + self._nodal(u, self.surface))
+                lam, changed, active, T, cdofs, K, r, du_c = self._exact_contact(
+                    f, K, gap, normal, curv, active, log)
             fixed = np.concatenate([self.fixed_base, cdofs])
             free = np.ones(self._nd, dtype=bool)
             free[fixed] = False
-            du_c = np.zeros(self._nd)
-            du_c[cdofs] = -gap[active] if self.obstacle.is_flat else np.concatenate(
-                [-gap[active & ~self.on_axis], -gap[active & self.on_axis]])
             ref = max(np.abs(r[fixed]).max(), 1e-300)
             res = float(np.abs(r[free]).max()) / ref
             # roundoff floor: F = I + ∇u carries strains next to 1, so stresses carry an
@@ -340,6 +405,8 @@ class IndentationSolver:
             f = self.disc.internal_force(real.P)
             known = (Fv, real, f)
             r = T.T @ f if T is not None else f
+            if self.k_penalty is not None:
+                r = f - self._penalty_force(trial)[5]
             s_a = float(np.dot(duf, r[free]))
             if abs(s_a) <= 0.5 * abs(s0):
                 return trial, known
@@ -435,7 +502,8 @@ class IndentationSolver:
             hist.residuals.append(res_hist)
             hist.profile_r.append(xs[0].copy())
             hist.profile_p.append(pressure)
-            hist.profile_g.append(np.where(active, 0.0, gap))
+            # penalty contact: the closed nodes' gap is their penetration
+            hist.profile_g.append(gap if self.k_penalty is not None else np.where(active, 0.0, gap))
             if progress is not None:
                 progress(h)
             if its <= opt.easy_iterations:
@@ -458,7 +526,7 @@ class IndentationSolver:
                   "indenter_radius": float(self.obstacle.radius), "h_max": h_max,
                   "mesh_density": self.hmesh.density, "element": self.disc.element,
                   "n_elements": self.disc.n_elements, "n_dofs": self._nd,
-                  "options": dict(vars(self.options))}
+                  "options": self.options.as_inputs()}
         return RunResult(inputs=inputs, curves=curves, residuals=hist.residuals,
                          profile_r=prof_r, profile_p=prof_p, profile_g=prof_g, status=status, reason=reason,
                          timings=timings, final=final)

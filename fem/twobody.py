@@ -107,6 +107,9 @@ class TwoBodySolver:
             raise ValueError("both bodies of the two-body scene must be deformable (finite E)")
         self.options = options or SolverOptions()
         self.options.validate()
+        if self.options.penalty is not None:
+            raise ValueError("options.penalty: the two-body solver has exact (Lagrange-multiplier) "
+                             "contact only; leave penalty=None")
         t0 = time.perf_counter()
         R_min = min(radius1, radius2)
         discs = [Discretisation(build_mesh(R, density, linear=(element == "q4"), contact_scale=R_min),
@@ -455,7 +458,7 @@ class TwoBodySolver:
                   "indenter_radius": b2.radius, "h_max": h_max,
                   "mesh_density": b1.hmesh.density, "element": b1.disc.element,
                   "n_elements": b1.disc.n_elements + b2.disc.n_elements, "n_dofs": self.n_dofs,
-                  "slave_body": self.slave_index + 1, "options": dict(vars(self.options))}
+                  "slave_body": self.slave_index + 1, "options": self.options.as_inputs()}
         return RunResult(inputs=inputs, curves=curves, residuals=residuals,
                          profile_r=np.array(prof_r).reshape(-1, n), profile_p=np.array(prof_p).reshape(-1, n),
                          profile_g=np.array(prof_g).reshape(-1, n), status=status, reason=reason,

@@ -17,7 +17,8 @@ rigid flat). Runs used:
 spherecontact.validation.fem_reports --out reports/validation/studies``): variants of
 the standard case, all with the current solver and timed on this machine one at a time:
 mesh densities 0.5, 1, 2; strain increments 0.0025–0.02; the locking element on the
-standard case; an extreme approach h/R = 0.6. They take precedence over verification runs
+standard case; an extreme approach h/R = 0.6; penalty contact at relative stiffnesses
+0.01–100 (``SolverOptions.penalty``). They take precedence over verification runs
 with the same inputs. Each is a JSON
 file ``<name>.json`` with ``inputs``, ``curves``, ``status``, ``reason``, ``timings``.
 """
@@ -39,17 +40,22 @@ STUDY_RUNS = ("standard", "standard_fine", "standard_dt2", "lock_q4", "lock_q8r"
               "lock_q8r_fine", "large_epp50", "large_epp500", "large_ludwik")
 
 
-#: the validation's own study runs: name → (strain_increment, element, h_max, mesh density) of the
-#: standard case
+#: the validation's own study runs: name → (strain_increment, element, h_max, mesh density,
+#: penalty or None for exact contact) of the standard case
 STUDY_VARIANTS = {
-    "standard_de0.005": (0.005, "q8r", 0.3, 1.0),
-    "standard_de0.0025": (0.0025, "q8r", 0.3, 1.0),
-    "standard_de0.01": (0.01, "q8r", 0.3, 1.0),
-    "standard_de0.02": (0.02, "q8r", 0.3, 1.0),
-    "standard_d0.5": (0.005, "q8r", 0.3, 0.5),
-    "standard_d2": (0.005, "q8r", 0.3, 2.0),
-    "standard_q4": (0.005, "q4", 0.3, 1.0),
-    "standard_extreme0.6": (0.005, "q8r", 0.6, 1.0),
+    "standard_de0.005": (0.005, "q8r", 0.3, 1.0, None),
+    "standard_de0.0025": (0.0025, "q8r", 0.3, 1.0, None),
+    "standard_de0.01": (0.01, "q8r", 0.3, 1.0, None),
+    "standard_de0.02": (0.02, "q8r", 0.3, 1.0, None),
+    "standard_d0.5": (0.005, "q8r", 0.3, 0.5, None),
+    "standard_d2": (0.005, "q8r", 0.3, 2.0, None),
+    "standard_q4": (0.005, "q4", 0.3, 1.0, None),
+    "standard_extreme0.6": (0.005, "q8r", 0.6, 1.0, None),
+    "standard_penalty0.01": (0.005, "q8r", 0.3, 1.0, 0.01),
+    "standard_penalty0.1": (0.005, "q8r", 0.3, 1.0, 0.1),
+    "standard_penalty1": (0.005, "q8r", 0.3, 1.0, 1.0),
+    "standard_penalty10": (0.005, "q8r", 0.3, 1.0, 10.0),
+    "standard_penalty100": (0.005, "q8r", 0.3, 1.0, 100.0),
 }
 
 
@@ -126,7 +132,8 @@ def _signature(c: Case) -> tuple:
     i = c.inputs
     m = i["material"]
     return (m["E"], m["nu"], m["sigma_y"], m.get("K", 0.0), m.get("n", 1.0), float(i["mesh_density"]),
-            i.get("element", "q8r"), float(i["options"]["strain_increment"]), round(float(i["h_max"]), 6))
+            i.get("element", "q8r"), float(i["options"]["strain_increment"]), round(float(i["h_max"]), 6),
+            i["options"].get("penalty"))
 
 
 def load_fallback(verification_dir, study_dir) -> list[Case]:
@@ -147,14 +154,15 @@ def run_study_variants(out_dir, names=None) -> list[Path]:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     written = []
-    for name, (de, element, h_max, density) in STUDY_VARIANTS.items():
+    for name, (de, element, h_max, density, penalty) in STUDY_VARIANTS.items():
         path = out_dir / f"{name}.json"
         if (names and name not in names) or path.exists():
             continue
         t0 = time.perf_counter()
         res = run_indentation(Material(E=200.0, nu=0.3, sigma_y=1.0), 1.0, h_max, element=element,
                               density=density,
-                              options=SolverOptions(strain_increment=de, max_wall_s=1800.0))
+                              options=SolverOptions(strain_increment=de, max_wall_s=1800.0,
+                                                    penalty=penalty))
         timings = {k: float(v) for k, v in res.timings.items()}
         timings.setdefault("wall_s", time.perf_counter() - t0)
         inputs = json.loads(json.dumps(res.inputs, default=float))
