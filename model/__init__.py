@@ -7,8 +7,12 @@ Public API::
     st.F, st.a, st.h1, st.h2, st.stiffness
 
 ``ContactLaw`` is the tabulated fast path for many contacts of one sphere pair.
+
+Inputs outside the range the coefficients were calibrated on give a
+``CalibrationRangeWarning`` (a ``UserWarning``; ``Coefficients.calibrated_range``).
 """
 
+from .calibrated_range import CalibratedRange, CalibrationRangeWarning
 from .coefficients import Coefficients, default_coefficients, load_coefficients
 from .contact import ContactState, contact, contact_from_radius
 from .fast import ContactLaw, contact_table
@@ -26,4 +30,6 @@ __all__ = [
     "Coefficients",
     "load_coefficients",
     "default_coefficients",
+    "CalibratedRange",
+    "CalibrationRangeWarning",
 ]

@@ -32,6 +32,9 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   correction vanishes.
 
 Schema 1 files (the literature set) are still read; they have no collapse block.
+
+The input range the set was calibrated on is :attr:`Coefficients.calibrated_range`, read
+from ``provenance["calibrated_range"]`` (``calibrated_range.py``; a default when absent).
 """
 
 from __future__ import annotations
@@ -41,10 +44,12 @@ import json
 import math
 import os
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
+
+from .calibrated_range import CalibratedRange
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -298,6 +303,7 @@ class Coefficients:
         version = int(version)
         source = _choice(d, "source", "", SOURCES)
         provenance = _section(d, "provenance")
+        CalibratedRange.from_provenance(provenance)  # a malformed range block raises here
         beta = _number(d, "beta", "")
         if beta <= 0.0:
             raise ValueError(f"coefficients: 'beta' must be > 0, got {beta!r}")
@@ -435,6 +441,13 @@ class Coefficients:
                 raise ValueError(f"coefficients: unknown key {k!r}")
             d[k] = v
         return Coefficients.from_dict(d)
+
+    @cached_property
+    def calibrated_range(self) -> CalibratedRange:
+        """Inputs the set was calibrated on: ``provenance["calibrated_range"]``, or
+        :data:`~spherecontact.model.calibrated_range.DEFAULT_RANGE` (the calibration design
+        of the FE campaign) when the provenance records none."""
+        return CalibratedRange.from_provenance(self.provenance)
 
     # ------------------------------------------------------------------ Level I and III values
     @property

@@ -1,6 +1,9 @@
 """Public entry point: ``contact(s1, s2, h)`` — force, contact radius, split and stiffness.
 
 h ≤ 0 means no contact: F = a = h1 = h2 = stiffness = 0 there (not an error).
+Inputs outside the calibrated range give a
+:class:`~spherecontact.model.calibrated_range.CalibrationRangeWarning` per cause and call
+(``range_check.py``); the values are still returned.
 """
 
 from __future__ import annotations
@@ -10,6 +13,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
+from .range_check import emit, range_check
 from .sphere import Sphere
 from .unified import UnifiedState, pair
 
@@ -63,18 +67,28 @@ def contact(s1: Sphere, s2: Sphere, h, coeffs: Coefficients | None = None) -> Co
     -------
     ContactState with F, a, h1, h2, stiffness = dF/dh, p_m, κ, ρ_1, ρ_2 shaped like h
     (NumPy scalars for scalar h). Outside contact all fields are 0 except ρ_i (inf).
+
+    Warns
+    -----
+    CalibrationRangeWarning, once per cause and call, for materials, pairs, approaches
+    (h/R), contact radii (a/R) or Λ outside the coefficient set's calibrated range.
     """
     hh = as_approach(h)
-    p = pair(s1, s2, default_coefficients() if coeffs is None else coeffs)
+    co = default_coefficients() if coeffs is None else coeffs
+    p = pair(s1, s2, co)
+    chk = range_check(s1, s2, co)
     flat = hh.reshape(-1)
     on = flat > 0.0
     out = {k: np.zeros(flat.shape) for k in ContactState._fields}
     out["rho1"][:] = np.inf
     out["rho2"][:] = np.inf
+    found = {}
     if np.any(on):
         st = p.state_from_h(flat[on])
         for k in ("F", "a", "h1", "h2", "stiffness", "p_m", "kappa", "rho1", "rho2"):
             out[k][on] = getattr(st, k)
+        found = chk.check_state(st)
+    emit([*chk.static.values(), *chk.messages(found)])
     return ContactState(**{k: _shaped(v.reshape(hh.shape)) for k, v in out.items()})
 
 
@@ -84,8 +98,13 @@ def contact_from_radius(s1: Sphere, s2: Sphere, a, coeffs: Coefficients | None =
 
     Returns the full :class:`~spherecontact.model.unified.UnifiedState` (κ, ρ_1, ρ_2,
     p_m, h_1, h_2, h, F, dF/dh, Λ_1, Λ_2) as 1-D arrays for contact radii a > 0.
+    Warns like :func:`contact`.
     """
     aa = as_approach(a).reshape(-1)
     if not np.all(aa > 0.0):
         raise ValueError("a (contact radius) must be > 0")
-    return pair(s1, s2, default_coefficients() if coeffs is None else coeffs).state_at_a(aa)
+    co = default_coefficients() if coeffs is None else coeffs
+    st = pair(s1, s2, co).state_at_a(aa)
+    chk = range_check(s1, s2, co)
+    emit([*chk.static.values(), *chk.messages(chk.check_state(st))])
+    return st

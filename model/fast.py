@@ -16,6 +16,15 @@ solve, so every input gets an answer of known accuracy.
 
 Evaluation is a uniform bucket lookup (no binary search), one gather of the interval's
 polynomial coefficients, a Horner step and one exponential: no loops over contacts.
+
+Calibrated range (``range_check.py``): material and pair causes warn once, when the
+table is built. The approach-dependent causes (h/R, a/R, Λ_i, flow-table slope) are
+tabulated at build time as their running maximum over the nodes, which gives for each
+cause the approach h where it first leaves the range; an evaluation compares only the
+largest approach of the call with the smallest of these (one reduction, no per-contact
+work), and a cause found warns once per ``ContactLaw`` (recorded in
+:attr:`ContactLaw.range_issues`) — never per contact or per time step. Approaches outside
+the table are checked on their exact states.
 """
 
 from __future__ import annotations
@@ -27,6 +36,7 @@ import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
 from .contact import ContactState, as_approach
+from .range_check import emit, range_check
 from .sphere import Sphere
 from .unified import UnifiedPair, UnifiedState, pair
 
@@ -63,13 +73,24 @@ class ContactLaw:
     error : dict of measured error bounds (relative) for ``F``, ``a``, ``stiffness``, ``h1``.
     setup_time : seconds spent building the table.
     nodes : number of table nodes; ``kinks``: the approaches h where the model has kinks.
+    range_issues : dict cause → message of every calibrated-range warning this law has
+        issued (material and pair causes at build; approach causes when first met).
+    h_calibrated : largest approach at which every approach-dependent check of the
+        calibrated range passes (h/R, a/R, Λ, flow-table slope).
+
+    Warns
+    -----
+    CalibrationRangeWarning: at build for materials or pairs outside the calibrated range;
+    at evaluation, once per law and cause, when approaches leave it.
     """
 
     def __init__(self, s1: Sphere, s2: Sphere, h_max: float | None = None,
                  h_min: float | None = None, coeffs: Coefficients | None = None,
                  rtol: float = 1e-6) -> None:
         t0 = time.perf_counter()
-        self.pair: UnifiedPair = pair(s1, s2, default_coefficients() if coeffs is None else coeffs)
+        co = default_coefficients() if coeffs is None else coeffs
+        self.pair: UnifiedPair = pair(s1, s2, co)
+        self._check = range_check(s1, s2, co)
         Rs = self.pair.R_star
         if h_max is None:
             h_max = 0.5 * min(s1.radius, s2.radius) if math.isfinite(min(s1.radius, s2.radius)) \
@@ -95,6 +116,10 @@ class ContactLaw:
                 break
             step *= 0.5
         self.kinks = np.exp(self._s[np.isin(self._lnX_nodes, kinks)]) if kinks.size else kinks
+        self.range_issues: dict[str, str] = {}
+        self._range_thresholds()
+        self.h_calibrated = self._h_trigger
+        self._report(self._check.static)
         self.setup_time = time.perf_counter() - t0
 
     # ------------------------------------------------------------------ construction
@@ -171,6 +196,7 @@ class ContactLaw:
         if not np.all(np.diff(yF) > 0.0) or not np.all(dF_l > 0.0) or not np.all(dF_r > 0.0):
             raise ValueError("the coefficient set gives a force F(h) that is not increasing")
         self._lnX_nodes = lnX
+        self._node_state = st
         self._s = s
         self._inv_ds = 1.0 / ds
         self._cF = _hermite(yF[:-1], yF[1:], dF_r[:-1], dF_l[1:], ds)
@@ -212,6 +238,70 @@ class ContactLaw:
             "h1": _SAFETY * float(np.max(np.abs(h1 - st.h1) / st.h)),
         }
 
+    # ------------------------------------------------------------------ calibrated range
+    def _range_thresholds(self) -> None:
+        """Running maximum of every approach-dependent check over the nodes, and the
+        approach where each first exceeds its limit (linear in ln h between nodes)."""
+        chk, st = self._check, self._node_state
+        vals = chk.values(st.h, st.a, st.Lambda1, st.Lambda2, st.rho1, st.rho2)
+        self._pending: dict[str, tuple[np.ndarray, float]] = {}
+        for key, v in vals.items():
+            lim = chk.limits[key]
+            run = np.maximum.accumulate(v)
+            if key == "h_over_R":
+                t = lim * chk.R_h
+            else:
+                above = np.nonzero(run > lim)[0]
+                if above.size == 0:
+                    t = math.inf
+                elif above[0] == 0:
+                    t = 0.0
+                else:
+                    j = above[0]
+                    f = (lim - run[j - 1]) / (run[j] - run[j - 1])
+                    t = math.exp(self._s[j - 1] + f * (self._s[j] - self._s[j - 1]))
+            self._pending[key] = (run, t)
+        self._update_trigger()
+
+    def _update_trigger(self) -> None:
+        self._h_trigger = min((t for _, t in self._pending.values()), default=math.inf)
+
+    def _table_causes(self, h_in: np.ndarray) -> dict[str, float]:
+        """Approach causes met by table points h_in: one max() unless the range is left."""
+        if h_in.size == 0 or not self._pending:
+            return {}
+        hi = float(h_in.max())
+        if hi <= self._h_trigger:
+            return {}
+        out = {}
+        chk = self._check
+        for key, (run, t) in self._pending.items():
+            if hi <= t:
+                continue
+            v = hi / chk.R_h if key == "h_over_R" else float(np.interp(math.log(hi), self._s, run))
+            if v > chk.limits[key]:
+                out[key] = v
+        return out
+
+    def _exact_causes(self, st: UnifiedState, found: dict[str, float]) -> dict[str, float]:
+        """Add the approach causes of exact states (points outside the table) to ``found``."""
+        if not self._pending:
+            return found
+        for key, v in self._check.check_state(st).items():
+            if key in self._pending:
+                found[key] = max(v, found.get(key, -math.inf))
+        return found
+
+    def _report(self, causes: dict) -> None:
+        """Warn once per cause (values: message or approach value); record it when issued."""
+        for key, v in causes.items():
+            msg = v if isinstance(v, str) else self._check.message(key, v)
+            emit([msg])  # may raise (filter "error"): then the cause stays pending
+            self.range_issues[key] = msg
+            if key in self._pending:
+                del self._pending[key]
+                self._update_trigger()
+
     # ------------------------------------------------------------------ evaluation
     def _index(self, s):
         b = ((s - self._s0) * self._inv_w).astype(np.intp)
@@ -250,15 +340,22 @@ class ContactLaw:
         inside = (flat >= self.h_min) & (flat <= self.h_max)
         if inside.all():
             F, k = self._eval(flat)
+            found = self._table_causes(flat)
         else:
             F = np.zeros(flat.shape)
             k = np.zeros(flat.shape)
+            found = {}
             if inside.any():
-                F[inside], k[inside] = self._eval(flat[inside])
+                hin = flat[inside]
+                F[inside], k[inside] = self._eval(hin)
+                found = self._table_causes(hin)
             out = ~inside & (flat > 0.0)
             if out.any():
                 st = self.pair.state_from_h(flat[out])
                 F[out], k[out] = st.F, st.stiffness
+                found = self._exact_causes(st, found)
+        if found:
+            self._report(found)
         F, k = F.reshape(hh.shape), k.reshape(hh.shape)
         return (F[()], k[()]) if hh.ndim == 0 else (F, k)
 
@@ -271,8 +368,10 @@ class ContactLaw:
         out["rho1"][:] = np.inf
         out["rho2"][:] = np.inf
         inside = (flat >= self.h_min) & (flat <= self.h_max)
+        found = {}
         if inside.any():
             hi = flat[inside]
+            found = self._table_causes(hi)
             F, k, a, h1 = self._eval(hi, full=True)
             out["F"][inside], out["stiffness"][inside], out["a"][inside] = F, k, a
             out["h1"][inside], out["h2"][inside] = h1, hi - h1
@@ -283,6 +382,9 @@ class ContactLaw:
             st = self.pair.state_from_h(flat[rest])
             for f in ("F", "a", "h1", "h2", "stiffness", "p_m", "kappa", "rho1", "rho2"):
                 out[f][rest] = getattr(st, f)
+            found = self._exact_causes(st, found)
+        if found:
+            self._report(found)
         shaped = {f: v.reshape(hh.shape) for f, v in out.items()}
         return ContactState(**{f: (v[()] if hh.ndim == 0 else v) for f, v in shaped.items()})
 
@@ -307,6 +409,8 @@ class ContactLaw:
             "h_min": self.h_min, "h_max": self.h_max, "nodes": self.nodes,
             "kinks_h": [float(x) for x in self.kinks], "error_bound": dict(self.error),
             "monotone": self.monotone, "setup_time_s": self.setup_time, "mode": self.pair.mode,
+            "h_calibrated": self.h_calibrated,
+            "calibrated_range_warnings": list(self.range_issues.values()),
         }
 
 

@@ -1,0 +1,164 @@
+"""The range of inputs the coefficient set was calibrated on, and the warning for leaving it.
+
+A coefficient file written by calibration carries the range of its FE data set in
+``provenance["calibrated_range"]``::
+
+    "calibrated_range": {
+        "E_over_sigma_y": [min, max],   # E/σ_Y of the calibration materials
+        "nu": [min, max],               # Poisson's ratio
+        "hardening_n": [min, max],      # hardening exponent n (0: perfectly plastic)
+        "h_over_R_max": x,              # largest approach h/R of the calibration runs
+        "a_over_R_max": y,              # largest contact radius a/R reached
+        "Lambda": [min, max]            # Johnson's parameter Λ reached (null: not recorded)
+    }
+
+Optional keys ``radius_ratio_max``, ``yield_ratio_max`` and ``E_ratio_max`` give the
+largest ratios of two deformable spheres covered by the data; without them the
+defaults below are used.
+
+Files without the block (the built-in literature set, files written before calibration
+recorded it) get :data:`DEFAULT_RANGE`: the calibration design of the FE campaign
+(``data/campaign.toml``, ``[[calibration]]`` entries: E/σ_Y 10–10000, ν 0.2–0.45,
+Ludwik n 0–0.5, approaches up to h/R = 0.3), a contact radius below the sphere
+radius (a/R < 1) and no Λ limit. Pairs of two deformable spheres: the
+``[[validation]]`` entries of the same campaign reach a radius ratio of 4, a
+yield-stress ratio of 3 and a Young's-modulus ratio of 3
+(:data:`DEFAULT_RADIUS_RATIO_MAX`, :data:`DEFAULT_YIELD_RATIO_MAX`,
+:data:`DEFAULT_E_RATIO_MAX`).
+
+Leaving the range is not an error: the model still returns values, but it
+extrapolates, and says so with a :class:`CalibrationRangeWarning` (a ``UserWarning``,
+filtered or escalated with the standard :mod:`warnings` machinery).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = [
+    "CalibrationRangeWarning",
+    "CalibratedRange",
+    "DEFAULT_RANGE",
+    "DEFAULT_RADIUS_RATIO_MAX",
+    "DEFAULT_YIELD_RATIO_MAX",
+    "DEFAULT_E_RATIO_MAX",
+    "RANGE_KEYS",
+]
+
+
+class CalibrationRangeWarning(UserWarning):
+    """The model is evaluated outside the range its coefficients were calibrated on.
+
+    The values returned are extrapolations. Silence with
+    ``warnings.filterwarnings("ignore", category=CalibrationRangeWarning)`` or make it an
+    error with ``warnings.filterwarnings("error", category=CalibrationRangeWarning)``.
+    """
+
+
+#: required keys of ``provenance["calibrated_range"]``
+RANGE_KEYS = ("E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "Lambda")
+#: largest ratio R_max/R_min of two deformable spheres of the validation set
+DEFAULT_RADIUS_RATIO_MAX = 4.0
+#: largest yield-stress ratio of two deformable spheres of the validation set
+DEFAULT_YIELD_RATIO_MAX = 3.0
+#: largest Young's-modulus ratio of two deformable spheres of the validation set
+DEFAULT_E_RATIO_MAX = 3.0
+
+
+def _where(key: str) -> str:
+    return f"provenance.calibrated_range.{key}"
+
+
+def _number(v, key: str) -> float:
+    if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+        raise ValueError(f"coefficients: '{_where(key)}' must be a finite number, got {v!r}")
+    return float(v)
+
+
+def _interval(v, key: str) -> tuple[float, float]:
+    if not isinstance(v, list | tuple) or len(v) != 2:
+        raise ValueError(f"coefficients: '{_where(key)}' must be a list [min, max], got {v!r}")
+    lo, hi = _number(v[0], key), _number(v[1], key)
+    if lo > hi:
+        raise ValueError(f"coefficients: '{_where(key)}' needs min <= max, got {v!r}")
+    return lo, hi
+
+
+def _positive(v, key: str) -> float:
+    x = _number(v, key)
+    if x <= 0.0:
+        raise ValueError(f"coefficients: '{_where(key)}' must be > 0, got {v!r}")
+    return x
+
+
+@dataclass(frozen=True)
+class CalibratedRange:
+    """Inputs covered by the calibration data (see the module docstring)."""
+
+    E_over_sigma_y: tuple[float, float]
+    nu: tuple[float, float]
+    hardening_n: tuple[float, float]
+    h_over_R_max: float
+    a_over_R_max: float
+    Lambda: tuple[float, float] | None = None
+    radius_ratio_max: float = DEFAULT_RADIUS_RATIO_MAX
+    yield_ratio_max: float = DEFAULT_YIELD_RATIO_MAX
+    E_ratio_max: float = DEFAULT_E_RATIO_MAX
+    source: str = "default"  # "provenance" (read from the coefficient set) or "default"
+
+    @classmethod
+    def from_provenance(cls, provenance: dict) -> CalibratedRange:
+        """The range of ``provenance["calibrated_range"]``, :data:`DEFAULT_RANGE` if absent.
+
+        A block that is present but malformed raises ValueError naming the key.
+        """
+        block = provenance.get("calibrated_range") if isinstance(provenance, dict) else None
+        if block is None:
+            return DEFAULT_RANGE
+        if not isinstance(block, dict):
+            raise ValueError("coefficients: 'provenance.calibrated_range' must be an object, got "
+                             f"{type(block).__name__}")
+        for key in RANGE_KEYS:
+            if key not in block:
+                raise ValueError(f"coefficients: missing key '{_where(key)}'")
+        lam = block["Lambda"]
+        return cls(
+            E_over_sigma_y=_interval(block["E_over_sigma_y"], "E_over_sigma_y"),
+            nu=_interval(block["nu"], "nu"),
+            hardening_n=_interval(block["hardening_n"], "hardening_n"),
+            h_over_R_max=_positive(block["h_over_R_max"], "h_over_R_max"),
+            a_over_R_max=_positive(block["a_over_R_max"], "a_over_R_max"),
+            Lambda=None if lam is None else _interval(lam, "Lambda"),
+            radius_ratio_max=_positive(block.get("radius_ratio_max", DEFAULT_RADIUS_RATIO_MAX),
+                                       "radius_ratio_max"),
+            yield_ratio_max=_positive(block.get("yield_ratio_max", DEFAULT_YIELD_RATIO_MAX),
+                                      "yield_ratio_max"),
+            E_ratio_max=_positive(block.get("E_ratio_max", DEFAULT_E_RATIO_MAX), "E_ratio_max"),
+            source="provenance",
+        )
+
+    def to_dict(self) -> dict:
+        """The ``provenance["calibrated_range"]`` block of this range."""
+        return {
+            "E_over_sigma_y": list(self.E_over_sigma_y), "nu": list(self.nu),
+            "hardening_n": list(self.hardening_n), "h_over_R_max": self.h_over_R_max,
+            "a_over_R_max": self.a_over_R_max,
+            "Lambda": None if self.Lambda is None else list(self.Lambda),
+            "radius_ratio_max": self.radius_ratio_max, "yield_ratio_max": self.yield_ratio_max,
+            "E_ratio_max": self.E_ratio_max,
+        }
+
+
+#: Range used when the coefficient set records none: the calibration design of the FE
+#: campaign (data/campaign.toml) — E/σ_Y 10–10000, ν 0.2–0.45, Ludwik n 0–0.5,
+#: h/R ≤ 0.3 —, a/R < 1 (the contact radius reaching the sphere radius), no Λ limit, and
+#: the pair ratios of the validation set (radius 4, yield stress 3, Young's modulus 3).
+DEFAULT_RANGE = CalibratedRange(
+    E_over_sigma_y=(10.0, 1e4),
+    nu=(0.2, 0.45),
+    hardening_n=(0.0, 0.5),
+    h_over_R_max=0.3,
+    a_over_R_max=1.0,
+    Lambda=None,
+)
