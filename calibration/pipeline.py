@@ -26,14 +26,15 @@ from pathlib import Path
 import numpy as np
 
 from ..model.coefficients import Coefficients
+from ..model.single import effective_exponent
 from .check import MonotoneCheck, RunError, check_all, run_errors
 from .crossval import CVResult, cross_validate
-from .dataset import Dataset, build_dataset
+from .dataset import Dataset, build_dataset, quantities
 from .fit import FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
 
 __all__ = ["Calibration", "calibrate_runs", "calibrate", "load_runs", "coefficient_file",
-           "write_json", "cv_score"]
+           "write_json", "cv_score", "calibrated_range"]
 
 #: relative E_cv margin within which the form with fewer parameters is preferred
 PARSIMONY = 0.02
@@ -203,6 +204,45 @@ def _stats(e) -> dict:
     return {"rms": round_sig(rms(e), 4), "max": round_sig(float(np.max(np.abs(e))), 4)}
 
 
+def _round_out(x: float, up: bool) -> float:
+    """``x`` to ``SIGNIFICANT`` digits, rounded outwards (a range end stays outside the data)."""
+    r = round_sig(x)
+    if (r < x if up else r > x) and abs(r - x) > 1e-12 * abs(x):
+        step = 10.0 ** (math.floor(math.log10(abs(x))) - 5)
+        r = round_sig(r + step if up else r - step)
+    return r
+
+
+def _interval(values) -> list[float]:
+    v = np.asarray(values, dtype=float)
+    return [_round_out(float(v.min()), False), _round_out(float(v.max()), True)]
+
+
+def calibrated_range(ds: Dataset, coeffs: Coefficients) -> dict:
+    """The inputs the fit saw, as ``provenance["calibrated_range"]`` (read by ``model/``).
+
+    Materials of the calibration runs used (E/σ_Y and the hardening exponent of the bodies
+    that yield, ν of all; n: the Ludwik exponent, 0 for perfect plasticity, the secant
+    exponent of the model for a flow table), and over the calibration points of the fit:
+    the largest approach h/R and contact radius a/R of the body, and the Λ range with the
+    fitted β. Ends rounded outwards to ``SIGNIFICANT`` digits.
+    """
+    mats = [c.material for c in ds.curves]
+    plastic = [m for m in mats if math.isfinite(m.sigma_y)]
+    ns = [effective_exponent(m, coeffs) if m.is_tabulated else (m.n if m.K > 0.0 else 0.0)
+          for m in plastic]
+    lam = quantities(ds, coeffs.beta)["Lambda"]
+    lam = lam[np.isfinite(lam) & (lam > 0.0)]
+    return {
+        "E_over_sigma_y": _interval([m.E / m.sigma_y for m in plastic]) if plastic else None,
+        "nu": _interval([m.nu for m in mats]),
+        "hardening_n": _interval(ns) if ns else None,
+        "h_over_R_max": _round_out(float(ds.h_R.max()), True),
+        "a_over_R_max": _round_out(float(ds.x_R.max()), True),
+        "Lambda": _interval(lam) if lam.size else None,
+    }
+
+
 def coefficient_file(cal: Calibration) -> dict:
     """The schema-2 dictionary written to ``data/coefficients.json``."""
     best = cal.best
@@ -239,6 +279,7 @@ def coefficient_file(cal: Calibration) -> dict:
         "model_error_note": "F(h), a(h) of the model in the FE scene against the resampled FE curves "
                             "(relative), a >= a_min",
         "monotone_check": {"pairs": len(cal.checks), "passed": sum(c.ok for c in cal.checks)},
+        "calibrated_range": calibrated_range(ds, best.coeffs),
         "notes": "Residuals are relative (model/FE - 1) over the calibration points; "
                  "see reports/calibration/index.md.",
     }

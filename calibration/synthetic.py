@@ -21,6 +21,7 @@ import numpy as np
 from ..fem.solver import RunResult
 from ..model import Material, Sphere, contact
 from ..model.coefficients import Coefficients
+from .check import quiet_range_warnings
 from .dataset import relative_radius
 
 __all__ = ["CALIBRATION_CASES", "hertz_result", "model_result", "write_database"]
@@ -82,7 +83,8 @@ def model_result(material: Material, coeffs: Coefficients, radius: float = 1.0,
     multiplicative noise of relative size ``noise`` on F and a (fixed seed)."""
     h = _h_grid(radius, h_max, n)
     partner = Sphere(indenter_radius, Material.rigid())
-    st = contact(Sphere(radius, material), partner, h, coeffs=coeffs)
+    with quiet_range_warnings():  # made-up runs may leave the range of ``coeffs``
+        st = contact(Sphere(radius, material), partner, h, coeffs=coeffs)
     F, a = np.asarray(st.F, dtype=float), np.asarray(st.a, dtype=float)
     if noise:
         rng = np.random.default_rng(seed)

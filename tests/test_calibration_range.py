@@ -1,0 +1,98 @@
+"""The calibrated range written by calibration (``provenance["calibrated_range"]``) matches
+the calibration records it was computed from."""
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_calibration import KNOWN_CO, SMALL, as_run
+
+from spherecontact.calibration.dataset import build_dataset, quantities
+from spherecontact.calibration.pipeline import (
+    calibrate_runs,
+    calibrated_range,
+    coefficient_file,
+    load_runs,
+)
+from spherecontact.calibration.synthetic import CALIBRATION_CASES, model_result
+from spherecontact.model.coefficients import Coefficients
+
+ROOT = Path(__file__).resolve().parents[1]
+SHIPPED_DB = ROOT / "data" / "reference.h5"
+SHIPPED = ROOT / "data" / "coefficients.json"
+#: the keys ``model/`` reads, in this shape
+KEYS = {"E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "Lambda"}
+
+
+def _expected(ds, beta) -> dict:
+    """The range straight from the records: materials of the runs, extremes over the points."""
+    mats = [c.material for c in ds.curves]
+    lam = quantities(ds, beta)["Lambda"]
+    return {"E_over_sigma_y": [min(m.E / m.sigma_y for m in mats), max(m.E / m.sigma_y for m in mats)],
+            "nu": [min(m.nu for m in mats), max(m.nu for m in mats)],
+            "hardening_n": [min(m.n if m.K > 0 else 0.0 for m in mats),
+                            max(m.n if m.K > 0 else 0.0 for m in mats)],
+            "h_over_R_max": float(ds.h_R.max()), "a_over_R_max": float(ds.x_R.max()),
+            "Lambda": [float(lam.min()), float(lam.max())]}
+
+
+def _assert_matches(block: dict, expected: dict) -> None:
+    assert set(block) == KEYS
+    for key, want in expected.items():
+        got = block[key]
+        if isinstance(want, list):
+            assert isinstance(got, list) and len(got) == 2, key
+            assert got[0] <= got[1], key
+            # ends rounded outwards to 6 significant digits: contain the data, within 1e-5
+            assert got[0] <= want[0] + 1e-12 * abs(want[0]) and got[1] >= want[1] * (1 - 1e-12), key
+            np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-12, err_msg=key)
+        else:
+            assert got >= want * (1 - 1e-12), key
+            assert got == pytest.approx(want, rel=1e-5), key
+
+
+def test_calibrated_range_is_written_and_matches_the_runs():
+    cases = [c for c in SMALL if not math.isinf(c[1].sigma_y)]
+    runs = [(case, as_run(model_result(m, KNOWN_CO, indenter_radius=Ri, seed=i)))
+            for i, (case, m, Ri) in enumerate(cases)]
+    cal = calibrate_runs(runs, candidates=("smooth",), cross_validation=False,
+                         large_deformation_options=False)
+    d = json.loads(json.dumps(coefficient_file(cal)))
+    block = d["provenance"]["calibrated_range"]
+    ds = cal.dataset
+    want = _expected(ds, cal.best.coeffs.beta)
+    _assert_matches(block, want)
+    # the cases of the synthetic grid: E/σY 10…10000, ν 0.3, Ludwik n 0 (perfectly plastic) … 0.5
+    assert block["E_over_sigma_y"] == [10.0, 10000.0]
+    assert block["nu"] == [0.3, 0.3]
+    assert block["hardening_n"] == [0.0, 0.5]
+    assert block["h_over_R_max"] == pytest.approx(max(float(r.h[-1]) / r.inputs["radius"]
+                                                      for _, r in runs), rel=1e-6)
+    Coefficients.from_dict(d)  # the file with its range still loads
+
+
+def test_calibrated_range_covers_a_dataset_of_other_runs():
+    cases = [c for c in CALIBRATION_CASES if c[0] in ("flat-E100-nu0.2", "flat-E1000-nu0.45",
+                                                      "flat-K2-n0.15-E100")]
+    runs = [(case, as_run(model_result(m, KNOWN_CO, indenter_radius=Ri, seed=i)))
+            for i, (case, m, Ri) in enumerate(cases)]
+    ds = build_dataset(runs)
+    block = calibrated_range(ds, KNOWN_CO)
+    _assert_matches(block, _expected(ds, KNOWN_CO.beta))
+    assert block["nu"] == [0.2, 0.45] and block["hardening_n"] == [0.0, 0.15]
+    assert block["E_over_sigma_y"] == [100.0, 1000.0]
+
+
+@pytest.mark.skipif(not SHIPPED_DB.exists(), reason="data/reference.h5 (the FE reference "
+                    "database) is not present; the synthetic version of this test runs")
+def test_shipped_file_records_the_range_of_its_calibration_runs():
+    d = json.loads(SHIPPED.read_text())
+    if d.get("source") != "calibration":
+        pytest.skip("data/coefficients.json is not a calibration yet")
+    runs, source = load_runs(SHIPPED_DB)
+    if source["calibration_runs_hash"] != d["provenance"]["fe_dataset"]["calibration_runs_hash"]:
+        pytest.skip("data/coefficients.json was calibrated on other calibration runs")
+    ds = build_dataset(runs)
+    _assert_matches(d["provenance"]["calibrated_range"], _expected(ds, d["beta"]))
