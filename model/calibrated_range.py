@@ -12,6 +12,9 @@ A coefficient file written by calibration carries the range of its FE data set i
         "Lambda": [min, max]            # Johnson's parameter Λ reached (null: not recorded)
     }
 
+A ``null`` entry means the data set recorded none (e.g. no body that yields): ``Lambda``
+is then not checked (small Λ is Level I, exact Hertz, and large Λ is bounded through
+E/σ_Y and h/R anyway), every other key takes its value from :data:`DEFAULT_RANGE`.
 Optional keys ``radius_ratio_max``, ``yield_ratio_max`` and ``E_ratio_max`` give the
 largest ratios of two deformable spheres covered by the data; without them the
 defaults below are used.
@@ -122,19 +125,21 @@ class CalibratedRange:
         for key in RANGE_KEYS:
             if key not in block:
                 raise ValueError(f"coefficients: missing key '{_where(key)}'")
+        def get(key, parse, optional=False):
+            v = block.get(key) if optional else block[key]
+            return getattr(DEFAULT_RANGE, key) if v is None else parse(v, key)
+
         lam = block["Lambda"]
         return cls(
-            E_over_sigma_y=_interval(block["E_over_sigma_y"], "E_over_sigma_y"),
-            nu=_interval(block["nu"], "nu"),
-            hardening_n=_interval(block["hardening_n"], "hardening_n"),
-            h_over_R_max=_positive(block["h_over_R_max"], "h_over_R_max"),
-            a_over_R_max=_positive(block["a_over_R_max"], "a_over_R_max"),
+            E_over_sigma_y=get("E_over_sigma_y", _interval),
+            nu=get("nu", _interval),
+            hardening_n=get("hardening_n", _interval),
+            h_over_R_max=get("h_over_R_max", _positive),
+            a_over_R_max=get("a_over_R_max", _positive),
             Lambda=None if lam is None else _interval(lam, "Lambda"),
-            radius_ratio_max=_positive(block.get("radius_ratio_max", DEFAULT_RADIUS_RATIO_MAX),
-                                       "radius_ratio_max"),
-            yield_ratio_max=_positive(block.get("yield_ratio_max", DEFAULT_YIELD_RATIO_MAX),
-                                      "yield_ratio_max"),
-            E_ratio_max=_positive(block.get("E_ratio_max", DEFAULT_E_RATIO_MAX), "E_ratio_max"),
+            radius_ratio_max=get("radius_ratio_max", _positive, optional=True),
+            yield_ratio_max=get("yield_ratio_max", _positive, optional=True),
+            E_ratio_max=get("E_ratio_max", _positive, optional=True),
             source="provenance",
         )
 

@@ -18,7 +18,7 @@ from spherecontact.model import (
     contact_from_radius,
 )
 from spherecontact.model.calibrated_range import DEFAULT_RANGE
-from spherecontact.model.coefficients import LITERATURE, Coefficients
+from spherecontact.model.coefficients import LITERATURE, Coefficients, default_path, load_coefficients
 
 CO = Coefficients.from_dict(LITERATURE)
 PP = Material(E=200.0, nu=0.3, sigma_y=1.0)                      # E/σ_Y 200, perfectly plastic
@@ -207,6 +207,20 @@ def test_malformed_range_block_raises_naming_the_key(key, bad):
     with pytest.raises(ValueError, match=f"missing key 'provenance.calibrated_range.{key}'"):
         _with_range(block)
     assert _with_range(dict(NARROW, Lambda=None)).calibrated_range.Lambda is None
+
+
+def test_null_entries_take_the_default_and_the_shipped_file_is_read():
+    rng = _with_range(dict(NARROW, E_over_sigma_y=None, hardening_n=None, Lambda=None)).calibrated_range
+    assert rng.E_over_sigma_y == DEFAULT_RANGE.E_over_sigma_y
+    assert rng.hardening_n == DEFAULT_RANGE.hardening_n and rng.nu == (0.25, 0.35)
+    shipped = load_coefficients(default_path()) if default_path().exists() else CO
+    block = shipped.provenance.get("calibrated_range")
+    if block is None:
+        assert shipped.calibrated_range == DEFAULT_RANGE
+    else:
+        assert shipped.calibrated_range.source == "provenance"
+        assert shipped.calibrated_range.h_over_R_max == block["h_over_R_max"]
+        assert list(shipped.calibrated_range.nu) == block["nu"]
 
 
 def test_range_check_costs_under_5_percent_of_a_table_evaluation():
