@@ -4,6 +4,12 @@ Cases: equal pair (exact, no κ solve), dissimilar pair (exact, nested κ solve)
 fast path (``ContactLaw`` table: setup time and throughput), and the explicit
 Jackson & Green (2005) formula on the same array as a cost reference.
 Approaches are log-uniform in [1e-6 R, 0.3 R]. Times are the best of ``REPEAT`` runs.
+
+``calibrated_range_checks``: cost of the calibrated-range checks (``model/range_check.py``)
+on 1e5 in-range contacts — the fast path's per-evaluation check (one max() against the
+thresholds tabulated at build) against a ``ContactLaw.force`` evaluation, the exact
+path's check of the solved state against ``contact()``, and the build-time thresholds
+against the table setup.
 """
 
 from __future__ import annotations
@@ -11,15 +17,18 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import numpy as np  # noqa: E402
 
-from spherecontact.model import Material, Sphere, contact  # noqa: E402
+from spherecontact.model import CalibrationRangeWarning, Material, Sphere, contact  # noqa: E402
 from spherecontact.model.coefficients import default_coefficients  # noqa: E402
 from spherecontact.model.fast import ContactLaw  # noqa: E402
+from spherecontact.model.range_check import range_check  # noqa: E402
+from spherecontact.model.unified import pair as unified_pair  # noqa: E402
 from spherecontact.validation.peers import jackson_green  # noqa: E402
 
 N = 1_000_000
@@ -36,6 +45,33 @@ def _best(fun, repeat=REPEAT) -> float:
         fun()
         times.append(time.perf_counter() - t0)
     return min(times)
+
+
+def range_check_overhead(co, n: int = 100_000) -> dict:
+    """Calibrated-range checks on n in-range contacts of an in-range dissimilar pair."""
+    s1 = Sphere(R, STEEL)
+    s2 = Sphere(2 * R, Material(E=110e9, nu=0.34, sigma_y=200e6, K=300e6, n=0.4))
+    rng = np.random.default_rng(1)
+    h = R * np.exp(rng.uniform(math.log(1e-6), math.log(0.3), n))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", CalibrationRangeWarning)  # the pair and h are in range
+        law = ContactLaw(s1, s2, coeffs=co)
+        t_force = _best(lambda: law.force(h), 20)
+        t_check = _best(lambda: law._table_causes(h), 20)
+        t_setup = _best(lambda: ContactLaw(s1, s2, coeffs=co), 5)
+        t_thresholds = _best(law._range_thresholds, 5)
+        t_contact = _best(lambda: contact(s1, s2, h, co), 2)
+        st = unified_pair(s1, s2, co).state_from_h(h)
+        chk = range_check(s1, s2, co)
+        t_state = _best(lambda: chk.check_state(st), 20)
+    return {
+        "contacts": n,
+        "fast_force_s": t_force, "fast_check_s": t_check, "fast_fraction": t_check / t_force,
+        "exact_contact_s": t_contact, "exact_check_s": t_state, "exact_fraction": t_state / t_contact,
+        "setup_s": t_setup, "setup_thresholds_s": t_thresholds,
+        "setup_fraction": t_thresholds / t_setup,
+        "target_fraction": 0.05,
+    }
 
 
 def main() -> dict:
@@ -87,6 +123,7 @@ def main() -> dict:
         "exact_dissimilar_pair": t_dis / t_jg,
     }
     out["target"] = {"fast_contacts_per_s": 1e7, "setup_s": 0.05}
+    out["calibrated_range_checks"] = range_check_overhead(co)
     return out
 
 
