@@ -2,7 +2,6 @@
 
 import copy
 import math
-import time
 import warnings
 
 import numpy as np
@@ -221,22 +220,3 @@ def test_null_entries_take_the_default_and_the_shipped_file_is_read():
         assert shipped.calibrated_range.source == "provenance"
         assert shipped.calibrated_range.h_over_R_max == block["h_over_R_max"]
         assert list(shipped.calibrated_range.nu) == block["nu"]
-
-
-def test_range_check_costs_under_5_percent_of_a_table_evaluation():
-    law = ContactLaw(Sphere(1.0, PP), Sphere(2.0, LUD), coeffs=CO)
-    h = np.exp(np.random.default_rng(0).uniform(math.log(1e-6), math.log(0.3), 100_000))
-
-    def best(fun, n=15):
-        ts = []
-        for _ in range(n):
-            t0 = time.perf_counter()
-            fun()
-            ts.append(time.perf_counter() - t0)
-        return min(ts)
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        t_force = best(lambda: law.force(h))
-        t_check = best(lambda: law._table_causes(h))
-    assert t_check < 0.05 * t_force
