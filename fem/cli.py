@@ -257,8 +257,9 @@ def _add_numerics(add) -> None:
     add(grp, "--no-line-search", action="store_true",
         help="full Newton steps (only the J > 0 guard); the default uses an energy line search")
     add(grp, "--penalty", type=float, default=None,
-        help="penalty contact with stiffness penalty * E / (pole element length), > 0, rigid "
-             "partner only; the default is exact contact (Lagrange multipliers)")
+        help="penalty contact with stiffness penalty * E / (pole element length), > 0 (two "
+             "bodies: symmetric two-pass, with E* of the pair); the default is exact contact "
+             "(Lagrange multipliers)")
 
 
 def _add_output(add) -> None:

@@ -214,10 +214,6 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
     if not isinstance(options, SolverOptions):
         raise ValueError(f"options must be a SolverOptions, got {type(options).__name__}")
     options.validate()
-    if chosen == "two_body" and options.penalty is not None:
-        raise ValueError("options.penalty: penalty contact exists for a rigid partner only (scenes "
-                         "rigid_flat, rigid_sphere, equal_pair_symmetry); two deformable bodies use "
-                         "the exact Lagrange-multiplier contact, leave penalty=None")
     if progress is not None and not callable(progress):
         raise ValueError("progress must be a callable progress(h) or None")
     return {"material": material, "radius": R, "h_max": h, "indenter_radius": R_ind,

@@ -55,6 +55,7 @@ class SolverOptions:
     line_search: bool = True  # energy line search (off: full Newton steps, J > 0 guard only)
     #: None: exact contact (Lagrange multipliers). A number: penalty contact with stiffness
     #: k_N = penalty · E / ℓ per unit reference area, ℓ the length of the pole's surface element
+    #: (two bodies: E* of the pair, symmetric two-pass; twobody.py)
     penalty: float | None = None
 
     def as_inputs(self) -> dict:
@@ -101,6 +102,7 @@ class History:
     profile_r: list = field(default_factory=list)
     profile_p: list = field(default_factory=list)
     profile_g: list = field(default_factory=list)
+    penetration: list = field(default_factory=list)
 
 
 @dataclass
@@ -494,6 +496,7 @@ class IndentationSolver:
             hist.a_nodes.append(a_nodes)
             hist.a_ref.append(a_ref)
             hist.eps_p_max.append(float(state.eps_p.max()))
+            hist.penetration.append(float(max(-gap.min(initial=0.0), 0.0)))
             hist.work_external.append(work)
             hist.energy_elastic.append(self.disc.integrate(upd.psi))
             hist.dissipation.append(state.dissipation)
@@ -512,6 +515,8 @@ class IndentationSolver:
         curves = {k: np.asarray(getattr(hist, k), dtype=float) for k in (
             "h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max", "work_external",
             "energy_elastic", "dissipation", "iterations", "active_changes")}
+        if self.k_penalty is not None:  # largest penetration of the penalty contact
+            curves["penetration"] = np.asarray(hist.penetration, dtype=float)
         finish_curves(curves)  # a: sub-element estimates smoothed over increments
         nsurf = self.surface.size
         prof_r = np.array(hist.profile_r).reshape(-1, nsurf)

@@ -98,45 +98,22 @@ class Body:
         return np.stack([X[0] + ul[2 * nodes], self.zsign * (X[1] + ul[2 * nodes + 1])])
 
 
-class TwoBodySolver:
-    """Two elastic–plastic hemispheres on one axis; call ``run(h_max)`` (h = h₁ + h₂)."""
+class ContactPass:
+    """The surface nodes of one body (slave) against the C¹ curve through the other's (master).
 
-    def __init__(self, material1: Material, radius1: float, material2: Material, radius2: float,
-                 density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None):
-        if material1.is_rigid or material2.is_rigid:
-            raise ValueError("both bodies of the two-body scene must be deformable (finite E)")
-        self.options = options or SolverOptions()
-        self.options.validate()
-        if self.options.penalty is not None:
-            raise ValueError("options.penalty: the two-body solver has exact (Lagrange-multiplier) "
-                             "contact only; leave penalty=None")
-        t0 = time.perf_counter()
-        R_min = min(radius1, radius2)
-        discs = [Discretisation(build_mesh(R, density, linear=(element == "q4"), contact_scale=R_min),
-                                element) for R in (radius1, radius2)]
-        self.t_setup = time.perf_counter() - t0
-        self.bodies = [Body(material1, float(radius1), discs[0], 0, False),
-                       Body(material2, float(radius2), discs[1], discs[0].n_dofs, True)]
-        self.n_dofs = sum(b.n_dofs for b in self.bodies)
-        self.R = min(radius1, radius2)
-        # the slave is the smaller sphere (finer surface mesh where the contact is)
-        self.slave_index = 1 if radius2 < radius1 else 0
-        self.slave = self.bodies[self.slave_index]
-        self.master = self.bodies[1 - self.slave_index]
-        self.candidates = self.slave.hmesh.surface[:-1]  # slave contact nodes, from the pole
-        self.master_arc = self.master.hmesh.surface  # corners at even, midsides at odd positions
+    ``weight`` scales the penalty force of this pass (½ each in the two-pass penalty
+    contact, so that an equal pair sees the stiffness of one pass).
+    """
+
+    def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0):
+        self.slave, self.master, self.n_dofs, self.weight = slave, master, n_dofs, weight
+        self.candidates = slave.hmesh.surface[:-1]  # slave contact nodes, from the pole
+        self.master_arc = master.hmesh.surface  # corners at even, midsides at odd positions
         self.ctrl_nodes, self.ctrl_rsign = self._control_points()
         # outward normal of the master: up for body 2 (below), down for body 1 (above)
-        self.side = 1.0 if self.master.mirror else -1.0
-        fixed = []
-        for b in self.bodies:
-            fixed += [b.offset + 2 * b.hmesh.equator + 1, b.offset + 2 * b.hmesh.axis]
-        self.fixed = np.unique(np.concatenate(fixed))
-        self.free = np.ones(self.n_dofs, dtype=bool)
-        self.free[self.fixed] = False
-        self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+        self.side = 1.0 if master.mirror else -1.0
+        self.area0 = surface_areas(slave.hmesh.X[:, slave.hmesh.surface])[:-1]
 
-    # ------------------------------------------------------------------ contact kinematics
     def _control_points(self):
         """Master node and r-sign of the 4 control points of every interval (4, n_int).
 
@@ -150,7 +127,7 @@ class TwoBodySolver:
         rsign = np.where(pos < 0, -1.0, 1.0)
         return arc[np.abs(pos)], rsign
 
-    def _kinematics(self, u: np.ndarray) -> Kinematics:
+    def kinematics(self, u: np.ndarray) -> Kinematics:
         """Master interval, gap coordinates, gap, ∂g and normal of every slave candidate at u."""
         xs = self.slave.positions(u, self.candidates)
         xm = self.master.positions(u, self.master_arc)
@@ -190,7 +167,7 @@ class TwoBodySolver:
                                 for b, rs in zip(bodies, rsigns, strict=True)])
         return dofs, signs
 
-    def _constraints(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
+    def constraints(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
         """G = ∂g/∂u of the active nodes (n_active × n_dofs) and Gᵀλ."""
         rows = np.flatnonzero(active)
         dofs, signs = self._dofs_and_signs(kin.seg, rows)
@@ -200,7 +177,7 @@ class TwoBodySolver:
         Gt_lam = np.bincount(dofs.ravel(), weights=(gl * lam[rows]).ravel(), minlength=self.n_dofs)
         return G, Gt_lam
 
-    def _contact_stiffness(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
+    def contact_stiffness(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
         """−Σ λ_i ∂²g_i over the active nodes (n_dofs × n_dofs), or None without contact."""
         rows = np.flatnonzero(active)
         if not rows.size:
@@ -211,6 +188,69 @@ class TwoBodySolver:
         r_idx = np.repeat(dofs[:, None, :], N_COORDS, axis=1).ravel()
         c_idx = np.repeat(dofs[None, :, :], N_COORDS, axis=0).ravel()
         return sp.csr_matrix((vals, (r_idx, c_idx)), shape=(self.n_dofs,) * 2)
+
+    def penalty_force(self, kin: Kinematics, k_n: float):
+        """Penalty contact of this pass (Wriggers 2006, §5.2): penetrating nodes, nodal forces
+        λ = w k_N A (−g) with the reference areas A of the slave nodes, and Gᵀλ."""
+        pen = kin.gap < 0.0
+        lam = np.where(pen, self.weight * k_n * self.area0 * -kin.gap, 0.0)
+        return pen, lam, self.constraints(kin, pen, lam)
+
+    def penalty_tangent(self, kin: Kinematics, k_n: float, pen, lam, G):
+        """∂(Gᵀλ)/∂u = w k_N Gᵀ diag(A) G − Σ λ ∂²g over the penetrating nodes."""
+        K = G.T @ sp.diags(self.weight * k_n * self.area0[pen]) @ G
+        Kh = self.contact_stiffness(kin, pen, lam)
+        return K if Kh is None else K + Kh
+
+
+class TwoBodySolver:
+    """Two elastic–plastic hemispheres on one axis; call ``run(h_max)`` (h = h₁ + h₂).
+
+    Contact: exact (Lagrange multipliers, one pass: slave = the smaller sphere) by
+    default; with ``options.penalty`` a symmetric two-pass penalty contact (each body's
+    nodes against the other's surface, half the stiffness each) with
+    k_N = penalty · E*/ℓ, E* the pair's contact modulus and ℓ the length of the pole's
+    surface element. An equal pair is then exactly symmetric under exchange of the bodies.
+    """
+
+    def __init__(self, material1: Material, radius1: float, material2: Material, radius2: float,
+                 density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None):
+        if material1.is_rigid or material2.is_rigid:
+            raise ValueError("both bodies of the two-body scene must be deformable (finite E)")
+        self.options = options or SolverOptions()
+        self.options.validate()
+        t0 = time.perf_counter()
+        R_min = min(radius1, radius2)
+        discs = [Discretisation(build_mesh(R, density, linear=(element == "q4"), contact_scale=R_min),
+                                element) for R in (radius1, radius2)]
+        self.t_setup = time.perf_counter() - t0
+        self.bodies = [Body(material1, float(radius1), discs[0], 0, False),
+                       Body(material2, float(radius2), discs[1], discs[0].n_dofs, True)]
+        self.n_dofs = sum(b.n_dofs for b in self.bodies)
+        self.R = min(radius1, radius2)
+        # the slave is the smaller sphere (finer surface mesh where the contact is)
+        self.slave_index = 1 if radius2 < radius1 else 0
+        self.slave = self.bodies[self.slave_index]
+        self.master = self.bodies[1 - self.slave_index]
+        self.k_penalty = None
+        if self.options.penalty is None:
+            self.passes = [ContactPass(self.slave, self.master, self.n_dofs)]
+        else:
+            self.passes = [ContactPass(self.slave, self.master, self.n_dofs, 0.5),
+                           ContactPass(self.master, self.slave, self.n_dofs, 0.5)]
+            x_arc = self.slave.hmesh.X[:, self.slave.hmesh.surface]
+            pole_edge = float(np.hypot(*(x_arc[:, 2] - x_arc[:, 0])))
+            e_star = 1.0 / (1.0 / material1.E_prime + 1.0 / material2.E_prime)
+            self.k_penalty = self.options.penalty * e_star / pole_edge
+        self.contact = self.passes[0]
+        self.candidates = self.contact.candidates
+        fixed = []
+        for b in self.bodies:
+            fixed += [b.offset + 2 * b.hmesh.equator + 1, b.offset + 2 * b.hmesh.axis]
+        self.fixed = np.unique(np.concatenate(fixed))
+        self.free = np.ones(self.n_dofs, dtype=bool)
+        self.free[self.fixed] = False
+        self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
 
     # ------------------------------------------------------------------ bodies
     def _stress(self, u, states, known=None):
@@ -247,12 +287,12 @@ class TwoBodySolver:
             K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body,
                                                                             strict=True)], format="csr")
             t2 = time.perf_counter()
-            kin = kin or self._kinematics(u)
+            kin = kin or self.contact.kinematics(u)
             changed = False
             if not log["frozen"]:
                 active, changed = update_active_set(active, lam, kin.gap, GAP_TOL * self.R, log)
                 lam = np.where(active, lam, 0.0)
-            G, Gt_lam = self._constraints(kin, active, lam)
+            G, Gt_lam = self.contact.constraints(kin, active, lam)
             r = f - Gt_lam
             ref = max(np.abs(r[~free]).max(), np.abs(Gt_lam).max(), 1e-300)
             res = float(np.abs(r[free]).max()) / ref
@@ -264,8 +304,9 @@ class TwoBodySolver:
             self.timers["constitutive"] += t1 - t0
             self.timers["assembly"] += t2 - t1
             if not changed and res <= max(opt.tol, floor) and gap_err <= GAP_TOL * self.R:
-                return u, per_body, f, active, lam, kin.gap, kin.normal, it, log
-            Kc = self._contact_stiffness(kin, active, lam)
+                F = abs(float(np.sum(lam * kin.normal[1])))
+                return u, per_body, f, active, lam, kin.gap, kin.normal, it, log, F
+            Kc = self.contact.contact_stiffness(kin, active, lam)
             t3 = time.perf_counter()
             self.timers["contact"] += t3 - t2
             if Kc is not None:
@@ -280,13 +321,14 @@ class TwoBodySolver:
             du[free] = sol[:free.sum()]
             lam = np.zeros_like(lam)
             lam[active] = scale * sol[free.sum():]
-            u, known, kin = self._line_search(u, du, f, kin, states, active, lam)
+            u, known, kin = self._line_search(u, du, f, kin, states, self._exact_force(active, lam))
             self.timers["solve"] += time.perf_counter() - t3
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {log['res'][-1]:.2e})")
 
-    def _line_search(self, u, du, f0, kin0, states, active, lam, max_steps: int = 4):
-        """Energy line search on the Lagrangian with the new multipliers fixed (cf. solver.py).
+    def _line_search(self, u, du, f0, kin0, states, contact_force, max_steps: int = 4):
+        """Energy line search on the Lagrangian with the new multipliers fixed (cf. solver.py);
+        ``contact_force(u, kin)`` → (Gᵀλ, kinematics) (penalty: λ follows u).
 
         Returns the new u and, when the accepted step was evaluated, its per-body
         (F, real stress update, internal force) and contact kinematics (else None, None).
@@ -302,8 +344,7 @@ class TwoBodySolver:
                 fb = b.disc.internal_force(real.P)
                 f[b.offset:b.offset + b.n_dofs] = fb
                 known.append((Fv, real, fb))
-            kin = self._kinematics(trial)
-            Gt_lam = self._constraints(kin, active, lam)[1]
+            Gt_lam, kin = contact_force(trial, None)
             return float(np.dot(duf, (f - Gt_lam)[free])), known, kin
 
         beta = 1.0
@@ -314,7 +355,7 @@ class TwoBodySolver:
         du = beta * du
         if not self.options.line_search:
             return u + du, None, None
-        s0 = float(np.dot(duf, (f0 - self._constraints(kin0, active, lam)[1])[free]))
+        s0 = float(np.dot(duf, (f0 - contact_force(u, kin0)[0])[free]))
         if s0 >= 0.0:
             return u + du, None, None
         alpha, lo, s_lo = 1.0, 0.0, s0
@@ -325,6 +366,66 @@ class TwoBodySolver:
                 return trial, known, kin
             alpha = float(np.clip(lo + (alpha - lo) * s_lo / (s_lo - s_a), 0.1 * alpha, alpha))
         return trial, known, kin
+
+    def _exact_force(self, active, lam):
+        """u, kinematics → (Gᵀλ, kinematics) with the active set and multipliers fixed."""
+        def force(u, kin):
+            kin = kin or self.contact.kinematics(u)
+            return self.contact.constraints(kin, active, lam)[1], kin
+        return force
+
+    def _penalty_force(self, u, kins=None):
+        """Σ over the passes of Gᵀλ at u, and the passes' kinematics."""
+        kins = kins or [p.kinematics(u) for p in self.passes]
+        return sum(p.penalty_force(k, self.k_penalty)[2][1] for p, k in zip(self.passes, kins,
+                                                                           strict=True)), kins
+
+    def _newton_penalty(self, u, states, active, lam):
+        """Newton with the two-pass penalty contact: K + K_c on the free dofs, no multipliers.
+        Returns what :meth:`_newton` returns; ``active``, λ, gap and normal are those of the
+        first pass, λ scaled to a whole pass (1/w)."""
+        opt, free = self.options, self.free
+        log = new_active_log()
+        known, kins, prev = None, None, None
+        for it in range(opt.max_iterations):
+            t0 = time.perf_counter()
+            per_body, f = self._stress(u, states, known)
+            t1 = time.perf_counter()
+            K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body,
+                                                                            strict=True)], format="csr")
+            t2 = time.perf_counter()
+            kins = kins or [p.kinematics(u) for p in self.passes]
+            r = f.copy()
+            pens, lams = [], []
+            for p, kin in zip(self.passes, kins, strict=True):
+                pen, lam_p, (G, Gt_lam) = p.penalty_force(kin, self.k_penalty)
+                r -= Gt_lam
+                K = K + p.penalty_tangent(kin, self.k_penalty, pen, lam_p, G)
+                pens.append(pen)
+                lams.append(lam_p)
+            changed = prev is None or any(not np.array_equal(a, b) for a, b in zip(pens, prev, strict=True))
+            log["changes"] += prev is not None and changed
+            prev = pens
+            ref = max(np.abs(r[~free]).max(), 1e-300)
+            res = float(np.abs(r[free]).max()) / ref
+            floor = ROUNDOFF * max(b.material.E for b in self.bodies) * self.R**2 / ref
+            log["res"].append(res)
+            self.timers["constitutive"] += t1 - t0
+            self.timers["assembly"] += t2 - t1
+            if not np.isfinite(res) or res > 1e6:
+                raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
+            if not changed and res <= max(opt.tol, floor):
+                kin0, p0 = kins[0], self.passes[0]
+                F = sum(abs(float(np.sum(lp * k.normal[1]))) for lp, k in zip(lams, kins, strict=True))
+                return (u, per_body, f, pens[0], lams[0] / p0.weight, kin0.gap, kin0.normal, it, log, F)
+            t3 = time.perf_counter()
+            self.timers["contact"] += t3 - t2
+            du = np.zeros(self.n_dofs)
+            du[free] = spla.splu(K[free][:, free].tocsc(), permc_spec="COLAMD").solve(-r[free])
+            u, known, kins = self._line_search(u, du, f, kins, states, self._penalty_force)
+            self.timers["solve"] += time.perf_counter() - t3
+        raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
+                              f"(last relative residual {log['res'][-1]:.2e})")
 
     # ------------------------------------------------------------------ the incremental run
     def _predictor(self, dh):
@@ -394,7 +495,8 @@ class TwoBodySolver:
             u_pred = self._predictor(dh) if u_prev is None else u + (dh / dh_prev) * (u - u_prev)
             u_pred = self._apply_bc(u_pred, h_new)
             try:
-                u_new, per_body, f, act, lam_new, gap, normal, its, log = self._newton(
+                newton = self._newton if self.k_penalty is None else self._newton_penalty
+                u_new, per_body, f, act, lam_new, gap, normal, its, log, F = newton(
                     u_pred, states, active.copy(), lam.copy())
             except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
                 self.rejected.append((h_new, dh, str(err)))
@@ -413,7 +515,6 @@ class TwoBodySolver:
             h = h_new
             b1, b2 = self.bodies
             F_support = -float(f[b1.offset + 2 * b1.hmesh.equator + 1].sum())
-            F = abs(float(np.sum(lam * normal[1])))
             xs = s.positions(u, self.candidates)
             arc = s.hmesh.surface
             areas = surface_areas(s.positions(u, arc))[:-1]
@@ -438,7 +539,7 @@ class TwoBodySolver:
             residuals.append(log["res"])
             prof_r.append(xs[0].copy())
             prof_p.append(pressure)
-            prof_g.append(np.where(active, 0.0, gap))
+            prof_g.append(gap if self.k_penalty is not None else np.where(active, 0.0, gap))
             if progress is not None:
                 progress(h)
             if its <= opt.easy_iterations:

@@ -12,7 +12,10 @@ runs the cases below, writes ``DIR/pair_verification.json``, ``DIR/pair.md`` and
   and h₁/h₂ against E'₂/E'₁ (the half-space centre displacements
   π p₀ a/(2E'ᵢ); Johnson 1985 §4.2), within 2 % at small h.
 * ``stiff``: a plastic body 1 (EPP E/σY = 200) against an elastic body 2 with
-  E₂/E₁ = 1000, against the rigid-sphere scene (R₂ = R₁), to h/R = 0.3: within 1 %.
+  E₂/E₁ = 1000, against the rigid-sphere scene (R₂ = R₁), to h/R = 0.3: within 1 %
+  in F (both forces smoothed over increments like a: each scene's F(h) ripples by a few %
+  at small h as single nodes close; the raw difference and that ripple are reported)
+  and in a.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model.material import Material
+from .contact import smooth_contact_radius
 from .io import run_indentation
 from .verification import save_run, saved_runs
 
@@ -59,6 +63,13 @@ def _run(name: str, kwargs: dict, outdir: Path) -> dict:
            "n_dofs": int(res.inputs["n_dofs"]), "wall_s": time.perf_counter() - t0}
     save_run(outdir, f"pair_{name}.json", out)
     return out
+
+
+def _with_smooth_force(run: dict) -> dict:
+    """The run with ``F_smooth``: F smoothed over increments like the contact radius."""
+    c = dict(run["curves"])
+    c["F_smooth"] = smooth_contact_radius(_curve(run, "h"), _curve(run, "F")).tolist()
+    return {**run, "curves": c}
 
 
 def _curve(run: dict, key: str) -> np.ndarray:
@@ -108,12 +119,21 @@ def evaluate(runs: dict, quick: bool) -> dict:
                     "h1_over_h2_dev_pct_small_h": 100 * float(np.abs(rh[small] - 1).max()),
                     "h1_over_h2_dev_pct_all": 100 * float(np.abs(rh - 1).max()),
                     "a_small_h_max": 0.02, "wall_s": hz["wall_s"]}
-    # stiff elastic body 2 against the rigid-sphere scene
+    # stiff elastic body 2 against the rigid-sphere scene. F(h) of both scenes ripples by a few %
+    # as single nodes close at small h; the method difference is measured on F smoothed like a
+    # (local power-law fit over 7 increments, contact.smooth_contact_radius), raw figures kept.
     st, rg = runs["stiff_two_body"], runs["stiff_rigid"]
     win = (0.005, _curve(rg, "h")[-1])
-    dF = _rel_on(rg, st, "F", _curve(rg, "h"), _curve(st, "h"), win)
+    dF_raw = _rel_on(rg, st, "F", _curve(rg, "h"), _curve(st, "h"), win)
+    st_s, rg_s = _with_smooth_force(st), _with_smooth_force(rg)
+    dF = _rel_on(rg_s, st_s, "F_smooth", _curve(rg, "h"), _curve(st, "h"), win)
     da = _rel_on(rg, st, "a", _curve(rg, "h"), _curve(st, "h"), win)
+    hr = _curve(rg, "h")
+    ripple = _curve(rg, "F")[hr >= win[0]] / _curve(rg_s, "F_smooth")[hr >= win[0]] - 1.0
     fig["stiff"] = {"window_h_over_R": list(win), "F_max_pct": 100 * float(np.abs(dF).max()),
+                    "F_rms_pct": 100 * float(np.sqrt(np.mean(dF**2))),
+                    "F_raw_max_pct": 100 * float(np.abs(dF_raw).max()),
+                    "F_ripple_rigid_max_pct": 100 * float(np.abs(ripple).max()),
                     "a_max_pct": 100 * float(np.abs(da).max()),
                     "h2_over_h_end": float(_curve(st, "h2")[-1] / _curve(st, "h")[-1]),
                     "wall_two_body_s": st["wall_s"], "wall_rigid_s": rg["wall_s"]}
@@ -176,7 +196,9 @@ def _report(fig: dict, png: str, outdir: Path, wall: float) -> None:
         f"| 2 % | {ok['hertz']} |",
         f"| EPP body 1 vs elastic body 2 with E₂/E₁ = 1000 against the rigid-sphere scene, "
         f"h/R {st['window_h_over_R'][0]:g}–{st['window_h_over_R'][1]:g} | F max "
-        f"{st['F_max_pct']:.2f} %, a max {st['a_max_pct']:.2f} %; h₂/h at the end "
+        f"{st['F_max_pct']:.2f} % (rms {st['F_rms_pct']:.2f} %) on F smoothed over 7 increments "
+        f"(raw {st['F_raw_max_pct']:.2f} %, while the rigid scene's own node-closure ripple is "
+        f"±{st['F_ripple_rigid_max_pct']:.1f} %), a max {st['a_max_pct']:.2f} %; h₂/h at the end "
         f"{st['h2_over_h_end']:.1e} | 1 % | {ok['stiff']} |", "",
         "Wall times (one core each, the other core busy): equal pair two bodies "
         f"{e['wall_two_body_s']:.0f} s ({e['dofs_two_body']} dofs) vs one on a flat "
