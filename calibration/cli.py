@@ -11,6 +11,7 @@ import sys
 import time
 
 from .forms import CANDIDATES, FORMS
+from .workers import DEFAULT_WORKERS
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -26,6 +27,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="report directory (index.md + PNG); '' for none")
     p.add_argument("--forms", default=",".join(CANDIDATES),
                    help=f"candidate forms, comma-separated (known: {', '.join(FORMS)})")
+    p.add_argument("--workers", type=int, default=DEFAULT_WORKERS,
+                   help="processes for the independent fits (folds, variants); the result does "
+                        f"not depend on it (default {DEFAULT_WORKERS})")
     p.add_argument("--converged-only", action="store_true",
                    help="leave out runs that stopped before h_max (default: fit their converged "
                         "increments)")
@@ -45,7 +49,8 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     try:
         cal = calibrate(args.db, out=args.out, report_dir=args.report or None,
-                        include_stopped=not args.converged_only, candidates=forms)
+                        include_stopped=not args.converged_only, candidates=forms,
+                        workers=args.workers)
     except FileNotFoundError as err:
         print(f"calibrate: error: reference database not found: {err.filename or args.db}",
               file=sys.stderr)

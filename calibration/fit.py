@@ -38,6 +38,9 @@ __all__ = ["SIGNIFICANT", "FitResult", "fit", "errors", "round_sig", "rms"]
 #: H̄(Λ) must not decrease in Level II: checked at these t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) and n
 MONOTONE_T = np.linspace(0.0, 1.0, 41)
 MONOTONE_N = np.linspace(0.0, 0.6, 7)
+#: ... and with the finite-size factor at these a/R
+MONOTONE_X = np.array([0.25, 0.5, 0.75, 1.0])
+_MONOTONE_NG = np.repeat(MONOTONE_N, MONOTONE_T.size)  # n of each row of the Λ × n grid
 PENALTY = 30.0
 #: collapse limits: log slopes checked at these a/R, kept this far from the limits ±2
 COLLAPSE_X = np.linspace(0.05, 1.0, 20)
@@ -102,17 +105,17 @@ def monotonicity_penalty(co: Coefficients) -> np.ndarray:
     """PENALTY · min(0, d ln H̄/d ln Λ) over Level II for n in ``MONOTONE_N``.
 
     The two-body κ solve needs p_m to rise with 1/ρ (DESIGN §3), i.e. H̄(Λ) must not
-    decrease: a Level II shape that overshoots H̄_III is penalised.
+    decrease: a Level II shape that overshoots H̄_III is penalised. Rows: the grid of
+    ``MONOTONE_T`` × ``MONOTONE_N`` (n-major), then the same with the Λ dependence of the
+    finite-size factor at each a/R of ``MONOTONE_X``.
     """
     L = co.Lambda_I * (co.Lambda_III / co.Lambda_I) ** MONOTONE_T
-    Lg, ng = np.meshgrid(L, MONOTONE_N)
-    _, sH = levels.H_bar_and_slope(Lg.ravel(), co, ng.ravel())
-    out = [sH]
+    _, sH = levels.H_bar_and_slope(np.tile(L, MONOTONE_N.size), co, _MONOTONE_NG)
     s, ds = levels.level_weight(L, co)
-    for x in (0.25, 0.5, 0.75, 1.0):  # with the finite-size factor's own Λ dependence
-        _, _, lf = levels.finite_size_by_level(x, s, ds, co.finite_size_H_bar, co.fs_H_bar_plastic)
-        out.append(sH + np.tile(np.broadcast_to(lf, s.shape), MONOTONE_N.size))
-    return PENALTY * np.minimum(np.concatenate(out), 0.0)
+    _, _, lf = levels.finite_size_by_level(MONOTONE_X[:, None], s, ds, co.finite_size_H_bar,
+                                           co.fs_H_bar_plastic)
+    lf = np.tile(np.broadcast_to(lf, (MONOTONE_X.size, L.size)), (1, MONOTONE_N.size))
+    return PENALTY * np.minimum(np.concatenate([sH, (sH + lf).ravel()]), 0.0)
 
 
 def collapse_penalty(co: Coefficients) -> np.ndarray:
@@ -138,33 +141,62 @@ def finite_size_penalty(co: Coefficients) -> np.ndarray:
     return PENALTY * np.minimum(np.concatenate(f) - FACTOR_MIN, 0.0)
 
 
+def _penalty_keys(co: Coefficients) -> tuple:
+    """What each penalty depends on: monotonicity (H̄ half-space law), collapse, finite size."""
+    fs = (co.finite_size_H_bar, co.finite_size_c2, co.fs_H_bar_plastic, co.fs_c2_plastic)
+    return ((co.Lambda_I, co.Lambda_III, co.H_bar_III_prefactor, co.H_bar_III_exp_poly,
+             co.H_bar_shape, co.level_II_smooth, fs[0], fs[2]),
+            (co.collapse_H_bar, co.collapse_c2), fs)
+
+
+#: penalty functions in the order of the residual rows, with the key part each one uses
+_PENALTIES = (monotonicity_penalty, collapse_penalty, finite_size_penalty)
+
+
 def _residuals(form: Form, ds: Dataset):
-    n_pen = 5 * MONOTONE_T.size * MONOTONE_N.size + 6 * COLLAPSE_X.size
+    """Residual function of ``form`` on ``ds``: data rows, then the penalty rows.
+
+    A finite-difference Jacobian moves one parameter at a time, which leaves most penalty
+    rows unchanged: each penalty is recomputed only when the coefficients it depends on
+    change (``_penalty_keys``; a small cache per function, same values).
+    """
+    n_pen = (1 + MONOTONE_X.size) * MONOTONE_T.size * MONOTONE_N.size + 6 * COLLAPSE_X.size
     bad = np.full(2 * ds.size + n_pen, 10.0)
+    caches: tuple[dict, ...] = tuple({} for _ in _PENALTIES)
+
+    def penalty(i: int, key, co: Coefficients) -> np.ndarray:
+        cache = caches[i]
+        v = cache.get(key)
+        if v is None:
+            if len(cache) > 256:
+                cache.clear()
+            v = cache[key] = _PENALTIES[i](co)
+        return v
 
     def f(params):
         try:
-            co = form.coefficients(params)
+            co = form.coefficients_unchecked(params)
         except ValueError:  # e.g. Λ_I ≥ Λ_III cannot happen with the log parametrisation
             return bad
         p, c = predict(ds, co)
+        keys = _penalty_keys(co)
         with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.concatenate([np.log(p / ds.p_m), np.log(c / ds.c2), monotonicity_penalty(co),
-                                collapse_penalty(co), finite_size_penalty(co)])
+            r = np.concatenate([np.log(p / ds.p_m), np.log(c / ds.c2)]
+                               + [penalty(i, k, co) for i, k in enumerate(keys)])
         return np.where(np.isfinite(r), r, 10.0)
 
     return f
 
 
-def _solve(form: Form, ds: Dataset, x0: np.ndarray, max_nfev: int | None):
+def _solve(form: Form, ds: Dataset, x0: np.ndarray, max_nfev: int | None, tol: float = TOL):
     lo, hi = form.bounds()
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
     return least_squares(_residuals(form, ds), x0, bounds=(lo, hi), x_scale="jac",
-                         method="trf", max_nfev=max_nfev or MAX_NFEV, ftol=TOL, xtol=TOL)
+                         method="trf", max_nfev=max_nfev or MAX_NFEV, ftol=tol, xtol=tol)
 
 
 def fit(ds: Dataset, form: Form, start: np.ndarray | None = None,
-        max_nfev: int | None = None) -> FitResult:
+        max_nfev: int | None = None, tol: float = TOL) -> FitResult:
     """Fit ``form`` to ``ds``.
 
     Parameters
@@ -173,10 +205,11 @@ def fit(ds: Dataset, form: Form, start: np.ndarray | None = None,
     form : candidate form.
     start : start parameters (warm start, e.g. the full fit for a cross-validation fold);
         default: the form's start values with the restarts ``RESTARTS``.
-    max_nfev : evaluation limit per solve (None: scipy's default).
+    max_nfev : evaluation limit per solve (None: ``MAX_NFEV``).
+    tol : stopping tolerance (relative change of cost and parameters).
     """
     if start is not None:
-        best = _solve(form, ds, np.asarray(start, dtype=float), max_nfev)
+        best = _solve(form, ds, np.asarray(start, dtype=float), max_nfev, tol)
         nfev = best.nfev
     else:
         best, nfev = None, 0
@@ -184,7 +217,7 @@ def fit(ds: Dataset, form: Form, start: np.ndarray | None = None,
         for r in RESTARTS:
             x0 = form.start()
             x0[i] = r
-            sol = _solve(form, ds, x0, max_nfev)
+            sol = _solve(form, ds, x0, max_nfev, tol)
             nfev += sol.nfev
             if best is None or sol.cost < best.cost:
                 best = sol

@@ -17,13 +17,14 @@ Free parameters of a form (bounds in :func:`Form.parameters`):
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..model import levels
-from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients
+from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients, CollapseLimit
 from ..model.single import BodyLaw, curvature_ratio, effective_exponent
 from .dataset import Dataset
 
@@ -91,7 +92,7 @@ class Form:
             p += [("ln_sharpness", math.log(2.0), math.log(0.5), math.log(30.0))]
         return p
 
-    @property
+    @functools.cached_property
     def names(self) -> list[str]:
         return [q[0] for q in self.parameters()]
 
@@ -149,9 +150,38 @@ class Form:
     def coefficients(self, params) -> Coefficients:
         return Coefficients.from_dict(self.to_dict(params))
 
+    def coefficients_unchecked(self, params) -> Coefficients:
+        """:meth:`coefficients` without the schema validation (equal sets; the fits' inner
+        loop, where the parametrisation already keeps every value valid)."""
+        return _unchecked(self.to_dict(params))
+
     @property
     def n_params(self) -> int:
         return len(self.parameters())
+
+
+def _limit(d: dict) -> CollapseLimit:
+    return CollapseLimit(prefactor=d["prefactor"], exponent=d["exponent"], x_poly=tuple(d["x_poly"]),
+                         exp_poly=tuple(d["exp_poly"]), z_poly=tuple(d["z_poly"]))
+
+
+def _unchecked(d: dict) -> Coefficients:
+    """The :class:`Coefficients` of a dictionary made by :meth:`Form.to_dict`, built directly
+    (what ``Coefficients.from_dict`` returns for it, without re-validating)."""
+    fs, lev2, col = d["finite_size"], d["level_II"], d["collapse"]
+    return Coefficients(
+        beta=d["beta"], Lambda_I=d["Lambda_I"], Lambda_III=d["Lambda_III"],
+        H_bar_III_prefactor=d["H_bar_III"]["prefactor"], H_bar_III_exp_poly=tuple(d["H_bar_III"]["exp_poly"]),
+        c2_III_prefactor=d["c2_III"]["prefactor"], c2_III_exp_poly=tuple(d["c2_III"]["exp_poly"]),
+        H_bar_shape=tuple(lev2["H_bar_shape"]), c2_shape=tuple(lev2["c2_shape"]),
+        exponent_method=d["hardening_exponent"]["method"], eps_lo=d["hardening_exponent"]["eps_lo"],
+        eps_hi=d["hardening_exponent"]["eps_hi"], finite_size_ratio=fs["ratio"],
+        finite_size_H_bar=tuple(fs["H_bar"]), finite_size_c2=tuple(fs["c2"]),
+        finite_size_H_bar_plastic=tuple(fs["H_bar_plastic"]), finite_size_c2_plastic=tuple(fs["c2_plastic"]),
+        collapse_H_bar=None if col is None else _limit(col["H_bar"]),
+        collapse_c2=None if col is None else _limit(col["c2"]),
+        collapse_sharpness=0.0 if col is None else col["sharpness"],
+        level_II_smooth=lev2["smooth"], source=d["source"], schema_version=d["schema_version"])
 
 
 def _shift_powers(d: list[float], x0: float) -> list[float]:
@@ -183,20 +213,85 @@ def _per_point(ds: Dataset, values) -> np.ndarray:
     return np.asarray(values, dtype=float)[ds.run]
 
 
+def _memo(ds: Dataset, kind: str, key: tuple, make):
+    """``make()`` memoised in ``ds.cache[kind]`` under ``key`` (at most 256 entries a kind)."""
+    store = ds.cache.setdefault(kind, {})
+    v = store.get(key)
+    if v is None:
+        if len(store) >= 256:
+            store.clear()
+        v = store[key] = make()
+    return v
+
+
 def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     """Model p_m and c² at the points of ``ds``, all runs in one vectorised pass.
 
     The same equations as :func:`predict_exact` (the model's ``BodyLaw.response``),
-    written with the model's level functions over all points at once: the fits
-    evaluate it thousands of times. Agreement is tested to rounding.
+    written with the model's level functions over all points at once (the collapse blend's
+    few lines repeated in :func:`_blend`): the fits evaluate it thousands of times.
+    Agreement is tested to rounding. The parts that depend on a few coefficients only
+    (σ_rep and Λ; H̄ and c² of the half space with their finite-size factors; the collapse
+    limits) are memoised in ``ds.cache`` by those coefficients: a finite-difference
+    Jacobian moves one parameter at a time and leaves most of them unchanged.
     """
-    mats = [c.material for c in ds.curves]
-    key = ("n_eff", coeffs.eps_lo, coeffs.eps_hi)
+    co = coeffs
+    key = ("n_eff", co.eps_lo, co.eps_hi)
     n_eff = ds.cache.get(key)
     if n_eff is None:
         n_eff = ds.cache[key] = _per_point(
-            ds, [0.0 if math.isinf(m.sigma_y) else effective_exponent(m, coeffs) for m in mats])
-    eps = coeffs.beta * ds.x_rho
+            ds, [0.0 if math.isinf(c.material.sigma_y) else effective_exponent(c.material, co)
+                 for c in ds.curves])
+    sig, Lam, elastic = _memo(ds, "sigma_rep", (co.beta,), lambda: _sigma_rep(ds, co.beta))
+    y = ds.x_R if co.finite_size_ratio == "a_over_R" else ds.x_rho
+    z = ds.cache.get("z")
+    if z is None:  # R/ρ − 1 of the rigid partner (ρ = Hertz relative radius)
+        z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
+    common = (co.beta, co.Lambda_I, co.Lambda_III, co.level_II_smooth, co.finite_size_ratio,
+              co.eps_lo, co.eps_hi)
+
+    def half_space(level_fn, fs_elastic, fs_plastic):
+        q, _ = level_fn(Lam, co, n_eff)
+        s_l, ds_l = levels.level_weight(Lam, co)
+        return q * levels.finite_size_by_level(y, s_l, ds_l, fs_elastic, fs_plastic)[0]
+
+    H = _memo(ds, "H_hs", common + (co.H_bar_III_prefactor, co.H_bar_III_exp_poly, co.H_bar_shape,
+                                    co.finite_size_H_bar, co.fs_H_bar_plastic),
+              lambda: half_space(levels.H_bar_and_slope, co.finite_size_H_bar, co.fs_H_bar_plastic))
+    c = _memo(ds, "c2_hs", common + (co.c2_III_prefactor, co.c2_III_exp_poly, co.c2_shape,
+                                     co.finite_size_c2, co.fs_c2_plastic),
+              lambda: half_space(levels.c2_and_slope, co.finite_size_c2, co.fs_c2_plastic))
+    if co.has_collapse:
+        where = (co.finite_size_ratio, co.eps_lo, co.eps_hi)
+        lnHc = _memo(ds, "ln_Hc", (co.collapse_H_bar,) + where,
+                     lambda: co.collapse_H_bar.log_and_slope(y, n_eff, z)[0])
+        lncc = _memo(ds, "ln_c2c", (co.collapse_c2,) + where,
+                     lambda: co.collapse_c2.log_and_slope(y, n_eff, z)[0])
+        H, c = _blend(H, c, lnHc, lncc, co.collapse_sharpness)
+    p = H * np.where(elastic, 1.0, sig)
+    if elastic.any():  # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor
+        hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
+            y, co.finite_size_H_bar)[0]
+        p = np.where(elastic, hertz, p)
+    return p, c
+
+
+def _blend(H_hs, c2_hs, lnHc, lncc, k: float):
+    """H̄ and c² of ``levels.collapse_blend`` from the limits' logarithms (the same lines)."""
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
+        z = k * lnr
+        w = np.where(z > 0.0, 1.0 / (1.0 + np.exp(-z)), np.exp(z) / (1.0 + np.exp(z)))
+        log1p = np.where(z > 0.0, z + np.log1p(np.exp(-z)), np.log1p(np.exp(z)))
+        H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
+        gap = np.where(w > 0.0, lncc - np.log(c2_hs), 0.0)
+        return H, c2_hs * np.exp(w * gap)
+
+
+def _sigma_rep(ds: Dataset, beta: float):
+    """σ_rep = σ_f(β a/ρ), Λ = E' (a/ρ)/σ_rep (0 for elastic bodies) and the elastic mask."""
+    mats = [c.material for c in ds.curves]
+    eps = beta * ds.x_rho
     if any(m.is_tabulated for m in mats):
         sig = np.empty(ds.size)
         for i, m in enumerate(mats):
@@ -209,22 +304,7 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
         sig = sy + K * eps**n
     elastic = ~np.isfinite(sig)
     Lam = np.where(elastic, 0.0, ds.E_prime * ds.x_rho / np.where(elastic, 1.0, sig))
-    ratio_R = coeffs.finite_size_ratio == "a_over_R"
-    y = ds.x_R if ratio_R else ds.x_rho
-    z = ds.cache.get("z")
-    if z is None:  # R/ρ − 1 of the rigid partner (ρ = Hertz relative radius)
-        z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
-    H, _ = levels.H_bar_and_slope(Lam, coeffs, n_eff)
-    c, _ = levels.c2_and_slope(Lam, coeffs, n_eff)
-    s_l, ds_l = levels.level_weight(Lam, coeffs)
-    H = H * levels.finite_size_by_level(y, s_l, ds_l, coeffs.finite_size_H_bar, coeffs.fs_H_bar_plastic)[0]
-    c = c * levels.finite_size_by_level(y, s_l, ds_l, coeffs.finite_size_c2, coeffs.fs_c2_plastic)[0]
-    b = levels.collapse_blend(H, c, y, coeffs, n_eff, z)
-    # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor (H̄ = 0 there)
-    hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
-        y, coeffs.finite_size_H_bar)[0]
-    p = np.where(elastic, hertz, b.H_bar * np.where(elastic, 1.0, sig))
-    return p, b.c2
+    return sig, Lam, elastic
 
 
 def hertz_start() -> Coefficients:
@@ -247,6 +327,17 @@ FORMS: dict[str, Form] = {
                     n_shape_c=2),
     "smooth2_fs": Form("smooth2_fs", "as smooth2, one finite-size coefficient for all levels",
                        smooth=True, n_shape_H=2, n_shape_c=2, finite_by_level=False),
+    "smooth2_fs2": Form("smooth2_fs2", "as smooth2, finite-size factors quadratic in a/R, "
+                        "Level I and Level III coefficients", smooth=True, n_shape_H=2, n_shape_c=2,
+                        n_finite_H=2, n_finite_c=2, finite_by_level=True),
+    "smooth2_ld": Form("smooth2_ld", "as smooth2_fs2, collapse limits quadratic in a/R and H̄_c "
+                       "quadratic in the hardening exponent", smooth=True, n_shape_H=2, n_shape_c=2,
+                       n_finite_H=2, n_finite_c=2, finite_by_level=True, n_collapse_H=2,
+                       n_collapse_c=2, n_collapse_nH=2),
+    "smooth2_ld3": Form("smooth2_ld3", "as smooth2_ld, collapse limits cubic in a/R, hardening "
+                        "exponent the secant between ε_p = 0.03 and 0.3", smooth=True, n_shape_H=2,
+                        n_shape_c=2, n_finite_H=2, n_finite_c=2, finite_by_level=True,
+                        n_collapse_H=3, n_collapse_c=3, n_collapse_nH=2, eps_lo=0.03, eps_hi=0.3),
 }
 #: forms compared by cross-validation in every calibration
-CANDIDATES = ("seed", "poly", "smooth", "smooth2", "smooth2_fs")
+CANDIDATES = ("seed", "poly", "smooth", "smooth2", "smooth2_fs", "smooth2_fs2", "smooth2_ld3")

@@ -1,0 +1,63 @@
+"""Independent fits (candidate forms, cross-validation folds) on worker processes.
+
+The fits of a calibration do not depend on each other once the full fits are known: the
+folds of every form, and the large-deformation variants, are separate least-squares
+problems on the same dataset. :class:`Workers` maps a module-level function over
+argument tuples, on ``workers`` forked processes that inherit the dataset (it is not
+sent with every task), or in this process with ``workers=1``. Every task is
+deterministic and single-threaded (BLAS threads are pinned to 1), and results come back
+in submission order, so the output does not depend on the number of workers.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+
+from .dataset import Dataset
+
+__all__ = ["DEFAULT_WORKERS", "Workers"]
+
+#: worker processes by default: the two cores of the reference machine (at most os.cpu_count())
+DEFAULT_WORKERS = 2
+
+_DATASET: Dataset | None = None  # the dataset of the pool being forked (inherited, not pickled)
+
+
+def _run(task):
+    fn, args = task
+    return fn(_DATASET, *args)
+
+
+class Workers:
+    """``map(fn, arglist)`` → ``[fn(ds, *args) for args in arglist]``, on forked processes.
+
+    Use as a context manager. Falls back to this process when ``workers`` ≤ 1, when the
+    platform cannot fork, or when only one task is given.
+    """
+
+    def __init__(self, ds: Dataset, workers: int = DEFAULT_WORKERS) -> None:
+        self.ds = ds
+        self.workers = max(1, min(int(workers), os.cpu_count() or 1))
+        self._pool: ProcessPoolExecutor | None = None
+
+    def __enter__(self) -> Workers:
+        global _DATASET
+        if self.workers > 1 and "fork" in multiprocessing.get_all_start_methods():
+            _DATASET = self.ds
+            self._pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("fork"))
+        return self
+
+    def __exit__(self, *exc) -> None:
+        global _DATASET
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+        _DATASET = None
+
+    def map(self, fn, arglist) -> list:
+        arglist = list(arglist)
+        if self._pool is None or len(arglist) < 2:
+            return [fn(self.ds, *args) for args in arglist]
+        return list(self._pool.map(_run, [(fn, args) for args in arglist]))

@@ -1,0 +1,95 @@
+"""Calibration internals: fast paths equal the plain ones, workers do not change results,
+the misfit breakdown and the noise floor."""
+
+import numpy as np
+import pytest
+from test_calibration import KNOWN_CO, SMALL, synthetic_runs
+
+from spherecontact.calibration import fit as fitmod
+from spherecontact.calibration.crossval import cross_validate, cross_validate_many
+from spherecontact.calibration.dataset import build_dataset
+from spherecontact.calibration.diagnostics import breakdown, noise_floor
+from spherecontact.calibration.fit import errors, fit
+from spherecontact.calibration.forms import FORMS, predict
+from spherecontact.calibration.workers import Workers
+
+
+@pytest.fixture(scope="module")
+def small_ds():
+    return build_dataset(synthetic_runs(SMALL, noise=0.002))
+
+
+@pytest.mark.parametrize("name", sorted(FORMS))
+def test_unchecked_coefficients_equal_the_validated_ones(name):
+    form = FORMS[name]
+    lo, hi = form.bounds()
+    rng = np.random.default_rng(7)
+    for _ in range(10):
+        p = lo + (hi - lo) * rng.random(form.n_params)
+        assert form.coefficients_unchecked(p) == form.coefficients(p)
+
+
+def test_residuals_with_memoised_parts_equal_a_fresh_evaluation(small_ds):
+    """The residual function caches penalties and ``predict`` memoises half-space parts:
+    a Jacobian-like sweep (one parameter moved at a time) gives the uncached values."""
+    form = FORMS["smooth2_ld3"]
+    f = fitmod._residuals(form, small_ds)
+    p0 = form.start()
+    for i in range(form.n_params):
+        for step in (1e-3, -2e-3):
+            p = p0.copy()
+            p[i] += step
+            co = form.coefficients(p)
+            pp, cc = predict(build_dataset_like(small_ds), co)
+            want = np.concatenate([np.log(pp / small_ds.p_m), np.log(cc / small_ds.c2),
+                                   fitmod.monotonicity_penalty(co), fitmod.collapse_penalty(co),
+                                   fitmod.finite_size_penalty(co)])
+            np.testing.assert_array_equal(f(p), np.where(np.isfinite(want), want, 10.0))
+
+
+def build_dataset_like(ds):
+    """A copy of ``ds`` with an empty cache (no memoised parts)."""
+    return ds.subset(range(len(ds.curves)))
+
+
+def test_workers_give_the_same_fits_and_folds(small_ds):
+    full = fit(small_ds, FORMS["smooth"])
+    serial = cross_validate(small_ds, full)
+    with Workers(small_ds, 2) as pool:
+        fits = pool.map(fit, [(FORMS["smooth"],), (FORMS["seed"],)])
+        parallel = cross_validate_many(small_ds, [full], workers=pool)[0]
+    np.testing.assert_array_equal(fits[0].params, full.params)
+    assert fits[0].coeff_dict == full.coeff_dict
+    for a, b in zip(serial.folds, parallel.folds, strict=True):
+        assert a.group == b.group
+        np.testing.assert_array_equal(a.params, b.params)
+        for q in ("H_bar", "c2"):
+            np.testing.assert_array_equal(a.errors[q], b.errors[q])
+
+
+def test_breakdown_shares_add_up_and_bands_cover_every_point(small_ds):
+    full = fit(small_ds, FORMS["smooth"])
+    b = breakdown(small_ds, full.coeffs, full.errors)
+    assert {"level", "a/R", "h/R", "hardening", "E/σY", "scene", "end of run"} <= set(b)
+    for rows in b.values():
+        assert sum(r["points"] for r in rows) == small_ds.size
+        assert sum(r["H_share"] for r in rows) == pytest.approx(1.0, abs=1e-12)
+        assert sum(r["c2_share"] for r in rows) == pytest.approx(1.0, abs=1e-12)
+        for r in rows:
+            assert r["H_max"] >= r["H_rms"] >= 0.0 and r["c2_max"] >= r["c2_rms"] >= 0.0
+
+
+def test_noise_floor_measures_the_scatter_of_the_points():
+    clean = build_dataset(synthetic_runs(SMALL))
+    nz0 = noise_floor(clean)
+    assert nz0["H_bar"] < 3e-4 and nz0["c2"] < 3e-4  # smooth curves: only the curvature
+    assert nz0["points"] > 0.8 * clean.size
+    noisy = build_dataset(synthetic_runs(SMALL, noise=0.002))
+    nz = noise_floor(noisy)
+    # 0.2 % on each increment of F and a, found again on the increments (a leave-one-out
+    # error is a little above the scatter itself)
+    assert 0.0018 < nz["F_increment"] < 0.0026 and 0.0018 < nz["a_increment"] < 0.0026
+    # the floor is what the generating coefficients (the exact law) score on the noisy points
+    e = errors(noisy, KNOWN_CO)
+    for q in ("H_bar", "c2"):
+        assert nz[q] == pytest.approx(fitmod.rms(e[q]), rel=0.25), q
