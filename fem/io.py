@@ -250,7 +250,7 @@ def run_indentation(material: Material, radius: float, h_max: float,
                     element: str = "q8r", options: SolverOptions | None = None,
                     progress: Callable[[float], object] | None = None,
                     radius2: float | None = None, material2: Material | None = None,
-                    scene: str = "auto") -> RunResult:
+                    scene: str = "auto", schedule=None) -> RunResult:
     """Press a hemisphere of ``radius`` and ``material`` on its partner up to ``h_max``.
 
     Partner: ``indenter_radius`` (rigid flat for inf, else a rigid sphere), or body 2
@@ -261,12 +261,16 @@ def run_indentation(material: Material, radius: float, h_max: float,
     ``density`` scales the mesh (``DENSITY_RANGE``), ``element`` is ``"q8r"``
     (8-node, reduced integration) or ``"q4"`` (bilinear, locks). Every input is
     checked before any mesh is built; ``progress(h)`` is called after each
-    converged increment. Returns the solver's ``RunResult``.
+    converged increment. ``schedule`` (one-body scenes): the approaches to step to
+    instead of adaptive increments (``IndentationSolver.run``). Returns the solver's
+    ``RunResult``.
     """
     a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
                      progress, radius2, material2, scene)
     chosen = a["scene"]
     if chosen == "two_body":
+        if schedule is not None:
+            raise ValueError("schedule: prescribed increments exist for the one-body scenes only")
         solver = TwoBodySolver(a["material"], a["radius"], a["material2"], a["radius2"],
                                density=a["density"], element=a["element"], options=a["options"])
         return solver.run(a["h_max"], progress=a["progress"])
@@ -281,7 +285,9 @@ def run_indentation(material: Material, radius: float, h_max: float,
     solver = IndentationSolver(a["material"], a["radius"],
                                obstacle=RigidObstacle(a["indenter_radius"]),
                                density=a["density"], element=a["element"], options=a["options"])
-    result = _with_pair_curves(solver.run(h_run, progress=progress), chosen)
+    if schedule is not None and chosen == "equal_pair_symmetry":
+        schedule = 0.5 * np.asarray(schedule, dtype=float)
+    result = _with_pair_curves(solver.run(h_run, progress=progress, schedule=schedule), chosen)
     if a["material2"] is not None and a["material2"].is_rigid:
         result.inputs.update(material2=a["material2"].describe(), radius2=a["radius2"])
     return result

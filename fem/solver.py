@@ -428,8 +428,13 @@ class IndentationSolver:
         raise IncrementFailed("inverted element (J <= 0) even after step halving")
 
     # ------------------------------------------------------------------ the incremental run
-    def run(self, h_max: float, progress=None) -> RunResult:
-        """Press the hemisphere to approach ``h_max``; ``progress(h)`` is called per increment."""
+    def run(self, h_max: float, progress=None, schedule=None) -> RunResult:
+        """Press the hemisphere to approach ``h_max``; ``progress(h)`` is called per increment.
+
+        ``schedule``: increasing approaches the run steps to instead of its adaptive
+        increments (cut back only where one fails), e.g. another run's approaches, so two runs
+        compare without the path dependence of plasticity on the increment sequence.
+        """
         R = self.radius
         h_max = float(h_max)
         if not (np.isfinite(h_max) and 0 < h_max <= 0.8 * R):
@@ -446,6 +451,13 @@ class IndentationSolver:
         active = np.zeros(self.surface.size, dtype=bool)
         hist = History()
         h, dh, dh_prev = 0.0, opt.dh_first * R, None
+        targets = None
+        if schedule is not None:
+            targets = np.asarray(schedule, dtype=float)
+            if targets.ndim != 1 or np.any(np.diff(targets) <= 0) or not np.all(targets > 0):
+                raise ValueError("schedule must be an increasing sequence of approaches > 0")
+            targets = np.append(targets[targets < h_max * (1 - 1e-12)], h_max)
+            dh = np.inf
         status, reason = "converged", "reached h_max"
         work = 0.0
         F_last = 0.0
@@ -455,7 +467,11 @@ class IndentationSolver:
                 reason = f"wall-time limit of {opt.max_wall_s:g} s reached at h/R = {h / R:.6g}"
                 break
             a_last = hist.a_nodes[-1] if hist.a_nodes else 0.0
-            dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
+            if targets is not None:
+                ahead = targets[targets > h * (1 + 1e-12)]
+                dh = min(dh, (ahead[0] if ahead.size else h_max) - h)
+            else:
+                dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
             h_new = h + dh
             if u_prev is None:
                 u_pred = u.copy()
@@ -509,7 +525,9 @@ class IndentationSolver:
             hist.profile_g.append(gap if self.k_penalty is not None else np.where(active, 0.0, gap))
             if progress is not None:
                 progress(h)
-            if its <= opt.easy_iterations:
+            if targets is not None:
+                dh = np.inf
+            elif its <= opt.easy_iterations:
                 dh *= opt.growth
         wall = time.perf_counter() - t_start
         curves = {k: np.asarray(getattr(hist, k), dtype=float) for k in (

@@ -125,3 +125,14 @@ def test_wall_time_limit_stops_with_reason_and_keeps_increments():
     res = solver.run(0.5)
     assert res.status == "stopped" and "wall-time" in res.reason
     assert 0 < res.h[-1] < 0.5 and res.h.size == len(res.residuals)
+
+
+def test_prescribed_schedule_is_followed_and_bad_ones_are_named():
+    """``run(schedule=...)`` steps to exactly the given approaches (h_max appended)."""
+    solver = IndentationSolver(Material(E=E, nu=NU, sigma_y=1.0), 1.0, density=0.5)
+    sched = np.array([0.0005, 0.001, 0.002, 0.0035])
+    res = solver.run(0.005, schedule=sched)
+    assert res.status == "converged"
+    np.testing.assert_allclose(res.h, np.append(sched, 0.005), rtol=1e-12)
+    with pytest.raises(ValueError, match="schedule"):
+        solver.run(0.005, schedule=[0.002, 0.001])
