@@ -179,8 +179,8 @@ def evaluate(runs: dict, quick: bool) -> dict:
     limits = {"equal": 0.5, "hertz": 1.0, "stiff": 1.0}
     e, hz, st = fig["equal"], fig["hertz"], fig["stiff"]
     fig["pass"] = {
-        "equal": (max(e["F_max_pct"], e["a_max_pct"]) <= limits["equal"]
-                  and e["h1_end"] >= 0.99 * e["window_h_over_R"][1]),
+        "equal": bool(max(e["F_max_pct"], e["a_max_pct"]) <= limits["equal"]
+                      and e["h1_end"] >= 0.99 * e["window_h_over_R"][1]),
         "hertz": hz["F_vs_a_max_pct"] <= limits["hertz"] and hz["h1_over_h2_dev_pct_small_h"] <= 2.0,
         "stiff": max(st["F_max_pct"], st["a_max_pct"]) <= limits["stiff"]}
     fig["quick"] = quick
@@ -243,7 +243,7 @@ def _report(fig: dict, png: str, outdir: Path, wall: float) -> None:
         "| check | figure | limit | result |", "|---|---|---|---|",
         f"| equal EPP pair as two bodies (symmetric two-pass penalty {PENALTY:g}) vs one on a flat "
         f"(same penalty, stepping to the pair's approaches), h/R {e['window_h_over_R'][0]:g}–"
-        f"{e['window_h_over_R'][1]:g} | F max {e['F_max_pct']:.2f} % (rms {e['F_rms_pct']:.2f} %), "
+        f"{e['window_h_over_R'][1]:g} | F max {e['F_max_pct']:.3f} % (rms {e['F_rms_pct']:.3f} %), "
         f"a max {e['a_max_pct']:.2f} % (rms {e['a_rms_pct']:.2f} %); h₁/h₂ − 1 ≤ "
         f"{e['h1_h2_max_dev_pct']:.1e} %; reached h₁/R = {e['h1_end']:.3g} | 0.5 % | {ok['equal']} |",
         *_extra_equal_rows(fig),
