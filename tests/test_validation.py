@@ -123,9 +123,14 @@ def test_peers_give_hertz_in_the_elastic_limit(scene, kw):
     for name in ("Hertz", "Jackson–Green 2005", "Kogut–Etsion 2002", "Thornton 1997"):
         assert np.allclose(pred[name].F, hz.F, rtol=1e-12), name
         assert np.allclose(pred[name].a, hz.a, rtol=1e-12), name
-    # and the model is exact Hertz there too
+    # and the model tends to Hertz there too: its finite-size terms are linear in a/R
+    # (DESIGN §2), so the relative difference is at most of order a/R and vanishes with it
     st = contact(s1, s2, h)
-    assert np.allclose(st.F, hz.F, rtol=1e-9) and np.allclose(st.a, hz.a, rtol=1e-9)
+    x = hz.a / min(s1.radius, s2.radius)
+    for q in ("F", "a"):
+        rel = np.abs(getattr(st, q) / getattr(hz, q) - 1)
+        assert np.all(rel <= 2.0 * x), q
+        assert rel[0] < 0.2 * rel[-1] + 1e-12, q  # a/R grows tenfold over h: so must the deviation
 
 
 def test_peer_applicability_reasons():
