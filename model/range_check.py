@@ -86,6 +86,11 @@ def emit(messages) -> None:
         warnings.warn(msg, CalibrationRangeWarning, stacklevel=_user_stacklevel())
 
 
+#: relative slack of the approach limits: a run that ends at h/R = 0.3 up to roundoff
+#: (0.30000000000000004) is inside h/R <= 0.3
+SLACK = 1.0 + 1e-9
+
+
 class RangeCheck:
     """Calibrated-range checks of one sphere pair under one coefficient set (module docstring).
 
@@ -111,16 +116,17 @@ class RangeCheck:
         finite_all = [s.radius for _, s in bodies if not s.is_flat]
         self.R_h = min(finite_def) if finite_def else min(finite_all)
         self.R_a = min(finite_all)
-        self.limits: dict[str, float] = {"h_over_R": rng.h_over_R_max, "a_over_R": rng.a_over_R_max}
+        self.limits: dict[str, float] = {"h_over_R": rng.h_over_R_max * SLACK,
+                                         "a_over_R": rng.a_over_R_max * SLACK}
         self._tables = {}
         for i, s in deform:
             m = s.material
             if math.isinf(m.sigma_y):
                 continue
             if rng.Lambda is not None:
-                self.limits[f"Lambda_{i}"] = rng.Lambda[1]
+                self.limits[f"Lambda_{i}"] = rng.Lambda[1] * SLACK
             if m.is_tabulated:
-                self.limits[f"flow_slope_{i}"] = rng.hardening_n[1]
+                self.limits[f"flow_slope_{i}"] = rng.hardening_n[1] * SLACK
                 self._tables[i] = m
 
     # ------------------------------------------------------------------ once per pair

@@ -219,8 +219,11 @@ def _probe_summary(probes) -> str:
     ]
     if errs:
         parts.append("The model raised an error for: " + ", ".join(errs) + ".")
+    silent = [n for n in over if not any("a/R" in w for p in probes if p.name == n for w in p.warnings)]
     if over:
-        parts.append("It returns a contact radius larger than the sphere (a > R) without complaint "
-                     "for: " + ", ".join(over) + ".")
+        parts.append("It returns a contact radius larger than the sphere (a > R), without clipping, "
+                     "for: " + ", ".join(over) + "; " + (
+                         "without a warning on a/R for: " + ", ".join(silent) + "." if silent else
+                         "each time with a warning on a/R."))
     return " ".join(parts)
 
