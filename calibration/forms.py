@@ -267,25 +267,13 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
                      lambda: co.collapse_H_bar.log_and_slope(y, n_eff, z)[0])
         lncc = _memo(ds, "ln_c2c", (co.collapse_c2,) + where,
                      lambda: co.collapse_c2.log_and_slope(y, n_eff, z)[0])
-        H, c = _blend(H, c, lnHc, lncc, co.collapse_sharpness)
+        H, c = levels.blend_from_logs(H, c, lnHc, lncc, co.collapse_sharpness)[:2]
     p = H * np.where(elastic, 1.0, sig)
     if elastic.any():  # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor
         hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
             y, co.finite_size_H_bar)[0]
         p = np.where(elastic, hertz, p)
     return p, c
-
-
-def _blend(H_hs, c2_hs, lnHc, lncc, k: float):
-    """H̄ and c² of ``levels.collapse_blend`` from the limits' logarithms (the same lines)."""
-    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
-        z = k * lnr
-        w = np.where(z > 0.0, 1.0 / (1.0 + np.exp(-z)), np.exp(z) / (1.0 + np.exp(z)))
-        log1p = np.where(z > 0.0, z + np.log1p(np.exp(-z)), np.log1p(np.exp(z)))
-        H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
-        gap = np.where(w > 0.0, lncc - np.log(c2_hs), 0.0)
-        return H, c2_hs * np.exp(w * gap)
 
 
 def _sigma_rep(ds: Dataset, beta: float):

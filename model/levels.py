@@ -210,6 +210,14 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     k = coeffs.collapse_sharpness
     lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, z)
     lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, z)
+    H, c, w, gap = blend_from_logs(H_hs, c2_hs, lnHc, lncc, k)
+    return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero)
+
+
+def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float):
+    """The blend of :func:`collapse_blend` from the limits' logarithms ln H̄_c, ln c²_c and the
+    sharpness k: returns H̄, c², the weight w = r^k/(1 + r^k) (r = H_hs/H̄_c) and
+    ln c²_c − ln c²_hs (0 where w = 0)."""
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
         # w = r^k/(1 + r^k) and ln(1 + r^k), without overflow
@@ -218,8 +226,7 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
         log1p = np.where(z > 0.0, z + np.log1p(np.exp(-z)), np.log1p(np.exp(z)))
         H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
         gap = np.where(w > 0.0, lncc - np.log(c2_hs), 0.0)
-        c = c2_hs * np.exp(w * gap)
-    return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero)
+        return H, c2_hs * np.exp(w * gap), w, gap
 
 
 def level_weight(Lambda, coeffs: Coefficients):
