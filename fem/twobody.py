@@ -270,6 +270,18 @@ class TwoBodySolver:
             out.append((Fv, upd, A))
         return out, f
 
+    def _bodies_state(self, u, states, known=None):
+        """:meth:`_stress` plus the block-diagonal tangent of both bodies, timed into
+        ``constitutive`` and ``assembly``. Returns (per body, internal force, K)."""
+        t0 = time.perf_counter()
+        per_body, f = self._stress(u, states, known)
+        t1 = time.perf_counter()
+        K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body, strict=True)],
+                          format="csr")
+        self.timers["constitutive"] += t1 - t0
+        self.timers["assembly"] += time.perf_counter() - t1
+        return per_body, f, K
+
     def _jacobians_positive(self, u) -> bool:
         return all(positive_jacobian(b.disc.deformation_gradient(b.local(u))) for b in self.bodies)
 
@@ -281,11 +293,7 @@ class TwoBodySolver:
         log = new_active_log()
         known, kin = None, None  # from the line search: stresses and contact kinematics at u
         for it in range(opt.max_iterations):
-            t0 = time.perf_counter()
-            per_body, f = self._stress(u, states, known)
-            t1 = time.perf_counter()
-            K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body,
-                                                                            strict=True)], format="csr")
+            per_body, f, K = self._bodies_state(u, states, known)
             t2 = time.perf_counter()
             kin = kin or self.contact.kinematics(u)
             changed = False
@@ -301,8 +309,6 @@ class TwoBodySolver:
             log["res"].append(res)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            self.timers["constitutive"] += t1 - t0
-            self.timers["assembly"] += t2 - t1
             if not changed and res <= max(opt.tol, floor) and gap_err <= GAP_TOL * self.R:
                 F = abs(float(np.sum(lam * kin.normal[1])))
                 return u, per_body, f, active, lam, kin.gap, kin.normal, it, log, F
@@ -388,11 +394,7 @@ class TwoBodySolver:
         log = new_active_log()
         known, kins, prev = None, None, None
         for it in range(opt.max_iterations):
-            t0 = time.perf_counter()
-            per_body, f = self._stress(u, states, known)
-            t1 = time.perf_counter()
-            K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body,
-                                                                            strict=True)], format="csr")
+            per_body, f, K = self._bodies_state(u, states, known)
             t2 = time.perf_counter()
             kins = kins or [p.kinematics(u) for p in self.passes]
             r = f.copy()
@@ -410,8 +412,6 @@ class TwoBodySolver:
             res = float(np.abs(r[free]).max()) / ref
             floor = ROUNDOFF * max(b.material.E for b in self.bodies) * self.R**2 / ref
             log["res"].append(res)
-            self.timers["constitutive"] += t1 - t0
-            self.timers["assembly"] += t2 - t1
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
             if not changed and res <= max(opt.tol, floor):
