@@ -143,6 +143,17 @@ class CalibratedRange:
             source="provenance",
         )
 
+    def describe(self) -> str:
+        """One line for reports: the ranges and where they come from."""
+        lam = "" if self.Lambda is None else f", Λ {self.Lambda[0]:g}–{self.Lambda[1]:g}"
+        where = ("the coefficient set's provenance" if self.source == "provenance"
+                 else "default: the campaign's calibration design")
+        return (f"E/σ_Y {self.E_over_sigma_y[0]:g}–{self.E_over_sigma_y[1]:g}, ν {self.nu[0]:g}–"
+                f"{self.nu[1]:g}, hardening exponent n {self.hardening_n[0]:g}–{self.hardening_n[1]:g}, "
+                f"h/R ≤ {self.h_over_R_max:g}, a/R ≤ {self.a_over_R_max:g}{lam}; pairs: radius ratio ≤ "
+                f"{self.radius_ratio_max:g}, yield ratio ≤ {self.yield_ratio_max:g}, E ratio ≤ "
+                f"{self.E_ratio_max:g} ({where})")
+
     def to_dict(self) -> dict:
         """The ``provenance["calibrated_range"]`` block of this range."""
         return {

@@ -62,10 +62,6 @@ def main(argv: list[str] | None = None) -> int:
             studies_source = (f"FE verification runs `{args.studies_fallback}/run_*.json` and study runs "
                               f"`{args.study_runs}/*.json` (the database has no `{args.studies_set}` "
                               "set)")
-        try:
-            calibration = load_records(db, "calibration")
-        except (KeyError, ValueError):
-            calibration = []
         records = load_records(db, args.set)
     except (OSError, ValueError) as err:
         print(f"validation: {err}", file=sys.stderr)
@@ -74,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
     skipped = [f"{r.case or r.key} ({r.status}: {r.reason})" for r in records if r.key not in compared]
     res = build_report(validation, studies, coeffs, th, args.out, source=str(db),
                        coeff_path=args.coefficients or "model default", th_path=args.thresholds,
-                       calibration_records=calibration, skipped=skipped,
+                       skipped=skipped,
                        studies_source=studies_source)
     dt = time.perf_counter() - t0
     print(f"validation: {len(res.comparisons)} runs, report {res.path} ({len(res.pngs)} charts), "

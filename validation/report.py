@@ -13,7 +13,6 @@ from .charts import curves_chart, error_chart, representative
 from .compare import W_ACCEPT, Comparison, compare_case
 from .config import Thresholds
 from .stability import (
-    calibrated_range,
     extreme_section,
     increment_section,
     locking_section,
@@ -75,7 +74,7 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
 
 def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficients | None,
                  th: Thresholds, out, *, source: str = "", coeff_path: str = "", th_path: str = "",
-                 calibration_records=None, skipped: list[str] | None = None,
+                 skipped: list[str] | None = None,
                  studies_source: str = "") -> ReportResult:
     """Compare every validation run, run the studies, write ``out/index.md`` and the PNGs."""
     out = Path(out)
@@ -173,7 +172,7 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
         ("Oversized increments", increment_section(studies, ref, th, out)),
         ("Extreme h/R", extreme_section(studies, coeffs, th, out)),
     ]
-    rng = calibrated_range(calibration_records)
+    rng = cf.calibrated_range  # what the model warns outside of
     probes = model_probes(coeffs, rng)
     sections.append(("The model outside its calibrated range", probes_section(probes, rng, out)))
     for title, (text, png) in sections:
@@ -219,7 +218,7 @@ def _probe_summary(probes) -> str:
     ]
     if errs:
         parts.append("The model raised an error for: " + ", ".join(errs) + ".")
-    silent = [n for n in over if not any("a/R" in w for p in probes if p.name == n for w in p.warnings)]
+    silent = [p.name for p in probes if p.name in over and not any("a/R" in w for w in p.warnings)]
     if over:
         parts.append("It returns a contact radius larger than the sphere (a > R), without clipping, "
                      "for: " + ", ".join(over) + "; " + (

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import Coefficients, Material, Sphere, contact
+from ..model.calibrated_range import CalibratedRange
 from .cases import Case, reference_radius, spheres
 from .charts import DPI, pyplot
 from .config import Thresholds
@@ -34,7 +35,7 @@ from .studies import DEFAULTS, Reference, energy_balance, standard_runs, variant
 from .tables import markdown_table, pct
 
 __all__ = ["pair_error", "locking_section", "penalty_section", "increment_section",
-           "extreme_section", "CalibratedRange", "calibrated_range", "Probe", "model_probes",
+           "extreme_section", "Probe", "model_probes",
            "probes_section"]
 
 
@@ -288,44 +289,6 @@ def extreme_section(cases: list[Case], coeffs: Coefficients | None, th: Threshol
 
 
 # ============================================================================ model outside range
-@dataclass(frozen=True)
-class CalibratedRange:
-    E_over_sigma_y: tuple[float, float]
-    nu: tuple[float, float]
-    n: tuple[float, float]
-    h_over_R_max: float
-    source: str
-
-    def describe(self) -> str:
-        return (f"E/σ_Y {self.E_over_sigma_y[0]:g}–{self.E_over_sigma_y[1]:g}, ν {self.nu[0]:g}–"
-                f"{self.nu[1]:g}, hardening exponent n {self.n[0]:g}–{self.n[1]:g}, h/R ≤ "
-                f"{self.h_over_R_max:g} ({self.source})")
-
-
-#: the calibration design of the campaign (issue text), used when no calibration record is readable
-DESIGN_RANGE = CalibratedRange((10.0, 1e4), (0.2, 0.45), (0.0, 0.5), 0.3,
-                               "campaign design; no calibration records read")
-
-
-def calibrated_range(records) -> CalibratedRange:
-    """Range of the calibration set from its records' inputs (E/σ_Y, ν, n, h_max/R)."""
-    E, nu, n, h = [], [], [], []
-    for r in records or []:
-        try:
-            m = r.inputs["material"]
-            if "sigma_y" in m and math.isfinite(float(m["sigma_y"])):
-                E.append(float(m["E"]) / float(m["sigma_y"]))
-            nu.append(float(m["nu"]))
-            n.append(float(m.get("n", 0.0)) if float(m.get("K", 0.0)) > 0 else 0.0)
-            h.append(float(r.inputs["h_max"]) / float(r.inputs.get("radius", 1.0)))
-        except (KeyError, TypeError, ValueError, AttributeError):
-            continue
-    if not E:
-        return DESIGN_RANGE
-    return CalibratedRange((min(E), max(E)), (min(nu), max(nu)), (min(n), max(n)), max(h),
-                           f"{len(E)} calibration records of the database")
-
-
 @dataclass
 class Probe:
     name: str
@@ -367,11 +330,12 @@ def model_probes(coeffs: Coefficients | None, rng: CalibratedRange, h_over_R_max
          Sphere(1.0, Material(E=E_hi * 10, nu=0.3, sigma_y=1.0)), flat),
         ("nearly incompressible", f"ν 0.49 (above {rng.nu[1]:g})",
          Sphere(1.0, Material(E=200.0, nu=0.49, sigma_y=1.0)), flat),
-        ("linear hardening", f"Ludwik K/σ_Y 5, n 1 (above n {rng.n[1]:g})",
+        ("linear hardening", f"Ludwik K/σ_Y 5, n 1 (above n {rng.hardening_n[1]:g})",
          Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=1.0, K=5.0, n=1.0)), flat),
         ("late hardening table", "flow table flat to ε 0.05, then to 3σ_Y at ε 0.5",
          Sphere(1.0, Material.from_table(200.0, 0.3, [0.0, 0.05, 0.5], [1.0, 1.0, 3.0])), flat),
-        ("extreme pair", "radius ratio 50, yield ratio 20, E ratio 10 (validated up to 4)",
+        ("extreme pair", f"radius ratio 50, yield ratio 20, E ratio 10 (calibrated up to "
+         f"{rng.radius_ratio_max:g}, {rng.yield_ratio_max:g}, {rng.E_ratio_max:g})",
          Sphere(1.0, pp), Sphere(50.0, Material(E=2000.0, nu=0.3, sigma_y=20.0))),
     ]
     out = []
