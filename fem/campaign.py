@@ -13,6 +13,10 @@ campaign loses at most the runs in flight. A run that raises is recorded under
 limit, increment below dh_min) is stored with status ``stopped``. At the end a
 table per set (converged / stopped / failed / missing, wall time) is printed and
 written to ``<db>.summary.json``.
+
+Entries whose key no case of the campaign produces any more (a case whose inputs
+or solver options changed gets a new key) are *superseded*: ``--dry-run`` lists
+them and ``--prune`` removes them, so a set never holds two runs of one case.
 """
 
 from __future__ import annotations
@@ -30,12 +34,13 @@ from dataclasses import dataclass
 from multiprocessing import get_context
 from pathlib import Path
 
-from ..data import Database, Record, append_run, remove_stale_temporaries
+from ..data import Database, Record, append_run, remove_entries, remove_stale_temporaries
 from .design import Campaign, Case, load_campaign
 from .io import provenance, run_indentation
 from .solver import RunResult
 
-__all__ = ["Outcome", "execute", "plan", "run_campaign", "summarize", "format_summary", "main"]
+__all__ = ["Outcome", "execute", "plan", "superseded", "prune", "run_campaign", "summarize",
+           "format_summary", "main"]
 
 #: thread counts of the numerical libraries in local workers (one core per run)
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -144,6 +149,20 @@ def plan(cases: list[Case], db: Database | None, retry_failed: bool = False,
     """The cases to run: missing ones, plus failed / stopped ones when asked to retry."""
     rerun = {"missing"} | ({"failed"} if retry_failed else set()) | ({"stopped"} if retry_stopped else set())
     return [c for c in cases if _state(db, c.key) in rerun]
+
+
+def superseded(campaign: Campaign, db: Database | None) -> list[Record]:
+    """Database entries whose key no case of ``campaign`` (any set) produces."""
+    if db is None:
+        return []
+    keys = {c.key for c in campaign.cases}
+    return sorted((db.record(k) for k in db if k not in keys), key=lambda r: (r.set, r.case))
+
+
+def prune(campaign: Campaign, db_path) -> list[Record]:
+    """Remove the superseded entries of the database ``db_path``; return them."""
+    db = _open_db(Path(db_path))
+    return remove_entries(db_path, [r.key for r in superseded(campaign, db)]) if db else []
 
 
 def _open_db(path: Path) -> Database | None:
@@ -278,6 +297,11 @@ def dry_run(campaign: Campaign, db_path, sets=None, only: str | None = None) -> 
         detail = ", ".join(f"{v} {k}" for k, v in sorted(cnt.items()))
         lines.append(f"{name}: {sum(cnt.values())} cases ({detail})")
     lines.append(f"total: {len(selected)} cases")
+    old = superseded(campaign, db)
+    if old:
+        lines += ["", f"{len(old)} superseded database entries (no case of the campaign has their key; "
+                      "--prune removes them):"]
+        lines += [f"{r.set:<12} {r.case:<{width}} {r.key} {r.status}" for r in old]
     return "\n".join(lines)
 
 
@@ -298,6 +322,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--retry-failed", action="store_true", help="rerun cases recorded as failed")
     p.add_argument("--retry-stopped", action="store_true",
                    help="rerun cases stored as stopped (e.g. after raising max_wall_s) and replace them")
+    p.add_argument("--prune", action="store_true",
+                   help="remove the database entries no case of the campaign produces (superseded "
+                        "inputs or options), print them, and run nothing")
     p.add_argument("--dry-run", action="store_true",
                    help="list the cases, their keys and whether they are in the database; run nothing")
     return p
@@ -323,6 +350,12 @@ def main(argv: list[str] | None = None) -> int:
         sets = _sets(campaign, args.set)
         if args.dry_run:
             print(dry_run(campaign, args.db, sets, args.only))
+            return 0
+        if args.prune:
+            removed = prune(campaign, args.db)
+            for r in removed:
+                print(f"removed {r.set} {r.case} {r.key} ({r.status})")
+            print(f"{len(removed)} superseded entries removed from {args.db}")
             return 0
         summary = run_campaign(campaign, args.db, sets=sets, only=args.only, workers=args.workers,
                                scheduler=args.scheduler, retry_failed=args.retry_failed,

@@ -53,7 +53,7 @@ from .fem.io import (
 from .fem.solver import RunResult
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "STATUSES", "Record", "Database", "input_key", "append_run",
-           "remove_stale_temporaries"]
+           "remove_entries", "remove_stale_temporaries"]
 
 SCHEMA = "spherecontact.database"
 SCHEMA_VERSION = 1
@@ -424,8 +424,9 @@ def _write_entry(f: h5py.File, record: Record, result: RunResult | None, prov: d
     g.attrs[INPUTS_ATTR] = _to_json(record.inputs)
 
 
-def _copy_without(src: Path, dst: Path, drop: str) -> None:
-    """Copy the database ``src`` to ``dst`` leaving out the group ``drop`` (space reclaimed)."""
+def _copy_without(src: Path, dst: Path, drop) -> None:
+    """Copy the database ``src`` to ``dst`` leaving out the group(s) ``drop`` (space reclaimed)."""
+    drop = {drop} if isinstance(drop, str) else set(drop)
     with h5py.File(src, "r") as fs, h5py.File(dst, "w") as fd:
         fd.attrs.update(dict(fs.attrs))
         for top in fs:
@@ -434,8 +435,41 @@ def _copy_without(src: Path, dst: Path, drop: str) -> None:
                 continue
             fd.create_group(top).attrs.update(dict(fs[top].attrs))
             for name in fs[top]:
-                if f"{top}/{name}" != drop:
+                if f"{top}/{name}" not in drop:
                     fs.copy(fs[top][name], fd[top], name=name)
+
+
+def remove_entries(path, keys) -> list[Record]:
+    """Remove the runs or failures ``keys`` from the database ``path``; return their records.
+
+    Used to drop entries the campaign no longer produces (e.g. after a case's solver
+    options changed, which changes its key). An unknown key is a ValueError and nothing
+    is removed. Crash-safe and serialised like :func:`append_run`.
+    """
+    path = Path(path)
+    keys = list(dict.fromkeys(keys))
+    with _directory_lock(path.parent):
+        db = Database(path)
+        unknown = [k for k in keys if k not in db]
+        if unknown:
+            raise ValueError(f"{path}: no entry with key {', '.join(unknown)}")
+        if not keys:
+            return []
+        removed = [db.record(k) for k in keys]
+        tmp = _temporary_sibling(path)
+        try:
+            _copy_without(path, tmp, [f"{FAILED if r.status == 'failed' else RUNS}/{r.key}"
+                                      for r in removed])
+            with h5py.File(tmp, "a") as f:
+                f.attrs["modified"] = _utc_now()
+                f.flush()
+            _fsync(tmp)
+            os.replace(tmp, path)
+            _fsync(path.parent)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+    return removed
 
 
 def append_run(path, record: Record, result: RunResult | None, prov: dict | None = None, *,

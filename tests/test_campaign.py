@@ -125,7 +125,10 @@ def test_shipped_campaign():
     assert not {x.key for x in cal} & {x.key for x in val}
     assert {x.scene for x in cal} == {"flat", "rigid_sphere"}
     assert sum(x.scene == "two_body" for x in val) == 6
-    assert all(x.params["h_max"] == 0.3 and x.max_wall_s == 900 for x in c.cases)
+    assert all(x.params["h_max"] == 0.3 for x in c.cases)
+    penalty = {x.name for x in c.cases if x.inputs["options"].get("penalty")}
+    assert penalty == {f"two-pp-E200-nu0.3-vs-{s}" for s in ("R2", "R4", "E600")}  # equal hardness
+    assert all(x.max_wall_s == (5400 if x.name in penalty else 900) for x in c.cases)
     assert set(PARAMETERS) >= {k for x in c.cases for k in x.params}
 
 
@@ -200,6 +203,47 @@ def test_dry_run_and_exit_codes(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "calibration" in out and "wall/run" in out
     assert [r.case for r in Database(db).records()] == ["flat-pp-E100-nu0.3"]
+
+
+def test_superseded_entries_are_listed_and_pruned(tmp_path, capsys):
+    body = '[[calibration]]\nscene = "flat"\nE_over_sigma_y = [100, 200]\n'
+    toml = tmp_path / "c.toml"
+    toml.write_text(tiny(body))
+    db_path = tmp_path / "ref.h5"
+    fc.run_campaign(load_campaign(toml), db_path, workers=0,
+                    runner=lambda case: fc.execute(case) if "E100" in case.name else
+                    fc.Outcome(case.key, "failed", "RuntimeError: no solver", 0.0))
+    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--prune"]) == 0
+    assert "0 superseded entries removed" in capsys.readouterr().out
+    # new solver options give both cases new keys: the old run and the old failure are superseded
+    toml.write_text(tiny(body).replace("dh_max = 0.005", "dh_max = 0.004"))
+    changed = load_campaign(toml)
+    old = fc.superseded(changed, Database(db_path))
+    assert sorted((r.case, r.status) for r in old) == [("flat-pp-E100-nu0.3", "converged"),
+                                                        ("flat-pp-E200-nu0.3", "failed")]
+    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--dry-run"]) == 0
+    out = capsys.readouterr().out
+    assert "2 superseded database entries" in out and "calibration: 2 cases (2 missing)" in out
+    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--prune"]) == 0
+    assert "2 superseded entries removed" in capsys.readouterr().out
+    db = Database(db_path)
+    assert len(db) == 0 and db.failed() == [] and fc.superseded(changed, db) == []
+
+
+def test_remove_entries_rejects_unknown_keys_and_keeps_the_rest(tmp_path):
+    from spherecontact.data import remove_entries
+    c = parse_campaign(tiny('[[calibration]]\nscene = "flat"\nE_over_sigma_y = [100, 200]\n'))
+    db_path = tmp_path / "ref.h5"
+    fc.run_campaign(c, db_path, workers=0)
+    keep, drop = (x.key for x in c.cases)
+    before = Database(db_path).run(keep)
+    with pytest.raises(ValueError, match="no entry with key 0123456789abcdef"):
+        remove_entries(db_path, [drop, "0123456789abcdef"])
+    assert len(Database(db_path)) == 2  # nothing removed
+    (gone,) = remove_entries(db_path, [drop])
+    db = Database(db_path)
+    assert gone.key == drop and list(db) == [keep]
+    assert (db.run(keep).F == before.F).all() and db.campaign["text"] == c.text
 
 
 # ---------------------------------------------------------------------------- kill and resume
