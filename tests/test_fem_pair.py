@@ -1,6 +1,7 @@
 """Two deformable spheres: gap derivatives, scene choice, bad pairs, Hertz with E*, R*."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -116,3 +117,17 @@ def test_equal_pair_as_two_bodies_matches_the_symmetric_scene():
     dF = np.interp(h, two.h, two.F) / np.interp(h, sym.h, sym.F) - 1
     # node-to-surface contact of two meshes is noisier than the symmetric scene
     assert np.sqrt(np.mean(dF**2)) < 0.01 and np.abs(dF).max() < 0.025
+
+
+def test_database_pairs_table_and_the_required_pairs():
+    """The pair report tabulates the database's two-body runs; R4 and sy3 must reach 0.3."""
+    from spherecontact.fem.verification_pair import REQUIRED_PAIRS, _pairs_pass, database_pairs
+    rows = database_pairs(Path(__file__).resolve().parents[1] / "data" / "reference.h5")
+    assert {r["case"].rsplit("-vs-", 1)[1] for r in rows} >= {s.removeprefix("vs-") for s in REQUIRED_PAIRS}
+    assert all(r["contact"] in ("exact one-pass", "two-pass penalty 100") for r in rows)
+    assert all(0 < r["h_end_over_R_min"] <= 0.3 + 1e-9 and r["wall_s"] > 0 for r in rows)
+    done = [{"case": f"two-x-{s}", "status": "converged", "h_end_over_R_min": 0.3} for s in REQUIRED_PAIRS]
+    assert _pairs_pass(done)
+    assert not _pairs_pass(done[:1])  # one required pair missing
+    short = [dict(done[0]), {**done[1], "status": "stopped", "h_end_over_R_min": 0.073}]
+    assert not _pairs_pass(short)
