@@ -76,7 +76,9 @@ class ContactLaw:
     range_issues : dict cause → message of every calibrated-range warning this law has
         issued (material and pair causes at build; approach causes when first met).
     h_calibrated : largest approach at which every approach-dependent check of the
-        calibrated range passes (h/R, a/R, Λ, flow-table slope).
+        calibrated range passes (h/R, a/R, Λ, flow-table slope); the h/R limit beyond the
+        table is extrapolated with the last node's shares h_i/h (exact for a rigid partner
+        and an equal pair); inf if no check is reached.
 
     Warns
     -----
@@ -243,13 +245,16 @@ class ContactLaw:
         """Running maximum of every approach-dependent check over the nodes, and the
         approach where each first exceeds its limit (linear in ln h between nodes)."""
         chk, st = self._check, self._node_state
-        vals = chk.values(st.h, st.a, st.Lambda1, st.Lambda2, st.rho1, st.rho2)
+        vals = chk.values(st)
         self._pending: dict[str, tuple[np.ndarray, float]] = {}
         for key, v in vals.items():
             lim = chk.limits[key]
             run = np.maximum.accumulate(v)
             if key == "h_over_R":
-                t = lim * chk.R_h
+                # h_i/R_i = h · r(h): r = run/h is constant for a rigid partner (1/R_1) and an
+                # equal pair (1/2R), so interpolating r keeps the check exact there
+                run = run / st.h
+                t = self._approach_limit(run, lim)
             else:
                 above = np.nonzero(run > lim)[0]
                 if above.size == 0:
@@ -262,6 +267,25 @@ class ContactLaw:
                     t = math.exp(self._s[j - 1] + f * (self._s[j] - self._s[j - 1]))
             self._pending[key] = (run, t)
         self._update_trigger()
+
+    def _ratio_at(self, r: np.ndarray, h: float) -> float:
+        """r(h) interpolated linearly in ln h (clamped to the end nodes)."""
+        return float(np.interp(math.log(h), self._s, r))
+
+    def _approach_limit(self, r: np.ndarray, lim: float) -> float:
+        """Smallest h with h · r(h) = lim; r > 0 varies slowly with h, so a fixed-point
+        iteration t = lim/r(t) converges in a few steps (beyond the table r is its last node's)."""
+        h = np.exp(self._s)
+        above = np.nonzero(h * r > lim)[0]
+        if above.size == 0:
+            return lim / r[-1] if r[-1] > 0.0 else math.inf
+        t = lim / r[above[0]]
+        for _ in range(20):
+            t_new = lim / self._ratio_at(r, t)
+            if abs(t_new - t) <= 1e-14 * t:
+                break
+            t = t_new
+        return t
 
     def _update_trigger(self) -> None:
         self._h_trigger = min((t for _, t in self._pending.values()), default=math.inf)
@@ -278,7 +302,8 @@ class ContactLaw:
         for key, (run, t) in self._pending.items():
             if hi <= t:
                 continue
-            v = hi / chk.R_h if key == "h_over_R" else float(np.interp(math.log(hi), self._s, run))
+            v = hi * self._ratio_at(run, hi) if key == "h_over_R" else \
+                float(np.interp(math.log(hi), self._s, run))
             if v > chk.limits[key]:
                 out[key] = v
         return out

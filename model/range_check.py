@@ -11,10 +11,13 @@ flats R = ∞ — they are the calibration scene):
 * pair of two deformable spheres, once per pair: R_max/R_min (both radii finite),
   E_max/E_min, and σ_Y,max/σ_Y,min (both bodies yield);
 * per call, over all contacts together (NumPy reductions, no loop over points):
-  h/R > ``h_over_R_max`` and a/R > ``a_over_R_max``, with R the smallest finite radius
-  of a deformable body (of any body if the deformable one is a flat) for h, and the
-  smallest finite radius of either body for a (a contact radius reaching the radius
-  of the sphere or of a rigid indenter); Λ_i above the largest calibrated Λ (when the
+  h/R > ``h_over_R_max`` and a/R > ``a_over_R_max``. The approach is that of each
+  deformable sphere over its own radius, max_i h_i/R_i: the calibration runs are one
+  sphere on a rigid flat or sphere, where h_1 = h, so an equal pair at a total approach
+  2h is as far in as its flat scene at h (if the only deformable body is a flat, the
+  total h over the smallest finite radius is used). For a the radius is the smallest
+  finite radius of either body (a contact radius reaching the radius of the sphere or
+  of a rigid indenter); Λ_i above the largest calibrated Λ (when the
   range records Λ: small Λ is Level I, exact Hertz); for a flow table, the local
   log slope d ln σ_f/d ln ε_p at the representative strain ε_rep = β a/ρ_i above the
   largest calibrated n (a Ludwik curve σ_Y + K εⁿ never exceeds its n).
@@ -112,9 +115,10 @@ class RangeCheck:
             self._material(i, s, coeffs)
         if len(deform) == 2:
             self._pair(s1, s2)
-        finite_def = [s.radius for _, s in deform if not s.is_flat]
+        #: (i, R_i) of the deformable spheres whose own approach h_i/R_i is checked
+        self.R_bodies = [(i, s.radius) for i, s in deform if not s.is_flat]
         finite_all = [s.radius for _, s in bodies if not s.is_flat]
-        self.R_h = min(finite_def) if finite_def else min(finite_all)
+        self.R_h = min(r for _, r in self.R_bodies) if self.R_bodies else min(finite_all)
         self.R_a = min(finite_all)
         self.limits: dict[str, float] = {"h_over_R": rng.h_over_R_max * SLACK,
                                          "a_over_R": rng.a_over_R_max * SLACK}
@@ -165,11 +169,20 @@ class RangeCheck:
                        ratio(m1.sigma_y, m2.sigma_y), (1.0, rng.yield_ratio_max), "the pair")
 
     # ------------------------------------------------------------------ per call
-    def values(self, h, a, Lambda1, Lambda2, rho1, rho2) -> dict[str, np.ndarray]:
-        """Per-point value of every approach-dependent check in :attr:`limits` (1-D arrays)."""
-        out = {"h_over_R": h / self.R_h, "a_over_R": a / self.R_a}
-        lam = {1: Lambda1, 2: Lambda2}
-        rho = {1: rho1, 2: rho2}
+    def approach_ratio(self, h, h1, h2) -> np.ndarray:
+        """max_i h_i/R_i over the deformable spheres (h/R_h without any): the h/R check."""
+        if not self.R_bodies:
+            return h / self.R_h
+        own = {1: h1, 2: h2}
+        return np.maximum.reduce([own[i] / R for i, R in self.R_bodies] + [np.zeros_like(h)])
+
+    def values(self, st) -> dict[str, np.ndarray]:
+        """Per-point value of every approach-dependent check in :attr:`limits` (1-D arrays)
+        for a :class:`~.unified.UnifiedState` ``st``."""
+        out = {"h_over_R": self.approach_ratio(st.h, st.h1, st.h2), "a_over_R": st.a / self.R_a}
+        lam = {1: st.Lambda1, 2: st.Lambda2}
+        rho = {1: st.rho1, 2: st.rho2}
+        a = st.a
         for key in self.limits:
             if key.startswith("Lambda_"):
                 out[key] = lam[int(key[-1])]
@@ -190,14 +203,16 @@ class RangeCheck:
 
     def check_state(self, st) -> dict[str, float]:
         """Out-of-range approach causes of a :class:`~.unified.UnifiedState` (largest values)."""
-        return self.exceeded(self.values(st.h, st.a, st.Lambda1, st.Lambda2, st.rho1, st.rho2))
+        return self.exceeded(self.values(st))
 
     def message(self, key: str, value: float) -> str:
         """Warning text of an approach cause at its (largest) value."""
         rng = self.range
         v = _fmt_out(value, -math.inf, self.limits[key])
         if key == "h_over_R":
-            return (f"h/R = {v} (largest approach over R = {_fmt(self.R_h)}) is outside "
+            what = ("largest approach of a sphere over its own radius" if self.R_bodies
+                    else f"largest approach over R = {_fmt(self.R_h)}")
+            return (f"h/R = {v} ({what}) is outside "
                     f"the calibrated range h/R <= {_fmt(rng.h_over_R_max)}{_TAIL}")
         if key == "a_over_R":
             return (f"a/R = {v} (largest contact radius over R = {_fmt(self.R_a)}) is "

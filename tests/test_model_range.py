@@ -18,7 +18,6 @@ from spherecontact.model import (
 )
 from spherecontact.model.calibrated_range import DEFAULT_RANGE
 from spherecontact.model.coefficients import LITERATURE, Coefficients, default_path, load_coefficients
-from spherecontact.model.range_check import SLACK
 
 CO = Coefficients.from_dict(LITERATURE)
 PP = Material(E=200.0, nu=0.3, sigma_y=1.0)                      # E/σ_Y 200, perfectly plastic
@@ -60,7 +59,8 @@ OUT_OF_RANGE = {
     "E_ratio": (Sphere(1.0, PP), Sphere(1.0, Material(E=2000.0, nu=0.3, sigma_y=1.0)), H_IN,
                 r"Young's modulus ratio E_max/E_min = 10 of the pair .*\[1, 3\]"),
     "h_over_R": (Sphere(1.0, PP), FLAT, np.geomspace(1e-4, 0.5, 50),
-                 r"h/R = 0\.5 \(largest approach over R = 1\) is outside the calibrated range h/R <= 0\.3"),
+                 r"h/R = 0\.5 \(largest approach of a sphere over its own radius\) is outside the "
+                 r"calibrated range h/R <= 0\.3"),
     "a_over_R": (Sphere(2.0, PP), Sphere(2.0, PP), np.array([0.1, 2.0]),
                  r"a/R = 1\.\d+ \(largest contact radius over R = 2\) .*a/R <= 1"),
 }
@@ -98,7 +98,12 @@ def test_in_range_call_raises_no_warning(name):
         law(H_IN)
         law.force(np.concatenate([H_IN, [1e-14, 0.0, -1.0]]))  # exact fallback below the table
     assert law.range_issues == {}
-    assert law.h_calibrated <= 0.3 * SLACK * min(s.radius for s in (s1, s2) if not s.is_rigid)
+    # at h_calibrated no sphere is beyond its own h_i/R_i = 0.3
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        end = contact(s1, s2, np.array([law.h_calibrated]), CO)
+    own = [h_i[0] / s.radius for h_i, s in ((end.h1, s1), (end.h2, s2)) if not s.is_rigid]
+    assert max(own) <= 0.3 * (1 + 1e-6)
 
 
 def test_filter_error_escalates_and_ignore_silences():
@@ -150,7 +155,7 @@ def test_table_warns_once_per_cause_not_per_evaluation():
 def test_table_approach_threshold_matches_the_exact_check():
     s1, s2 = Sphere(1.0, PP), Sphere(1.0, PP)    # equal spheres: a reaches R inside the table
     law = ContactLaw(s1, s2, h_max=3.0, coeffs=CO)
-    assert law.h_calibrated == pytest.approx(0.3)
+    assert law.h_calibrated == pytest.approx(0.6, rel=1e-8)  # each sphere at h/R = 0.3
     h_a = law._pending["a_over_R"][1]          # approach where a/R first reaches 1
     a_exact = contact(s1, s2, np.array([0.99 * h_a, 1.01 * h_a]), CO).a
     assert a_exact[0] < 1.0 < a_exact[1]
@@ -221,3 +226,27 @@ def test_null_entries_take_the_default_and_the_shipped_file_is_read():
         assert shipped.calibrated_range.source == "provenance"
         assert shipped.calibrated_range.h_over_R_max == block["h_over_R_max"]
         assert list(shipped.calibrated_range.nu) == block["nu"]
+
+
+def test_approach_check_is_per_sphere_like_the_calibration_scenes():
+    """Calibrated on one sphere against a rigid flat (h_1 = h): an equal pair at 2h is as far
+    in as its flat scene at h, and a dissimilar pair is limited by its sphere with the
+    largest h_i/R_i — in the exact check and in the table alike."""
+    eq, flat = ContactLaw(Sphere(1.0, PP), Sphere(1.0, PP), h_max=1.0, coeffs=CO), ContactLaw(
+        Sphere(1.0, PP), FLAT, coeffs=CO)
+    assert eq.h_calibrated == pytest.approx(2 * flat.h_calibrated, rel=1e-12)
+    assert flat.h_calibrated == pytest.approx(0.3, rel=1e-8)
+    for h, warns in ((0.6, False), (0.61, True)):
+        rec = _records(lambda h=h: contact(Sphere(1.0, PP), Sphere(1.0, PP), np.array([0.01, h]), CO))
+        assert any("h/R" in str(w.message) for w in rec) == warns
+    s1, s2 = Sphere(1.0, PP), Sphere(4.0, PP)            # radius ratio 4, equal materials
+    law = ContactLaw(s1, s2, h_max=1.0, coeffs=CO)
+    t = law._pending["h_over_R"][1]                       # where the h/R check is first exceeded
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        st = contact(s1, s2, np.array([t]), CO)
+    assert max(st.h1[0] / 1.0, st.h2[0] / 4.0) == pytest.approx(0.3, rel=1e-6)  # table == exact
+    assert t > 0.45                                       # body 2 takes part of the approach
+    for h, warns in ((0.999 * t, False), (1.001 * t, True)):
+        rec = _records(lambda h=h: ContactLaw(s1, s2, h_max=1.0, coeffs=CO).force(np.array([0.01, h])))
+        assert any("h/R" in str(w.message) for w in rec) == warns
