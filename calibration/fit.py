@@ -45,6 +45,7 @@ PENALTY = 30.0
 #: collapse limits: log slopes checked at these a/R, kept this far from the limits ±2
 COLLAPSE_X = np.linspace(0.05, 1.0, 20)
 SLOPE_MARGIN = 0.3
+_N_ENDS = np.array([[MONOTONE_N.max()], [0.0]])  # both ends of n (rows), broadcast against x
 #: finite-size factors stay above this on 0 ≤ a/R ≤ 1
 FACTOR_MIN = 0.2
 #: significant digits of the written coefficients
@@ -123,14 +124,14 @@ def collapse_penalty(co: Coefficients) -> np.ndarray:
 
     F = π a² p_m and h = a²/(2c²ρ) keep rising in the full-collapse limit if
     d ln H̄_c/d ln x ≥ −2 + SLOPE_MARGIN and d ln c²_c/d ln x ≤ 2 − SLOPE_MARGIN, also
-    beyond the calibrated range (extrapolation to larger approaches).
+    beyond the calibrated range (extrapolation to larger approaches); the slopes are linear
+    in n (x·n terms), so they are checked at both ends of ``MONOTONE_N``.
     """
     if not co.has_collapse:
         return np.zeros(2 * COLLAPSE_X.size)
-    _, sH, _ = co.collapse_H_bar.log_and_slope(COLLAPSE_X, MONOTONE_N.max())
-    _, sH0, _ = co.collapse_H_bar.log_and_slope(COLLAPSE_X, 0.0)
-    _, sc, _ = co.collapse_c2.log_and_slope(COLLAPSE_X)
-    return PENALTY * np.concatenate([np.minimum(np.minimum(sH, sH0) + 2.0 - SLOPE_MARGIN, 0.0),
+    sH = np.atleast_2d(co.collapse_H_bar.log_and_slope(COLLAPSE_X, _N_ENDS)[1]).min(axis=0)
+    sc = np.atleast_2d(co.collapse_c2.log_and_slope(COLLAPSE_X, _N_ENDS)[1]).max(axis=0)
+    return PENALTY * np.concatenate([np.minimum(sH + 2.0 - SLOPE_MARGIN, 0.0),
                                      np.minimum(2.0 - SLOPE_MARGIN - sc, 0.0)])
 
 

@@ -12,7 +12,9 @@ Free parameters of a form (bounds in :func:`Form.parameters`):
 * Level II shape terms b_k (``n_shape``), straight (seed), polynomial or smooth (C¹ Hermite);
 * finite-size factor 1 + Σ f_k x^(k+1) on H̄ and c² (``n_finite``);
 * optional collapse blend (``collapse``): ln H̄_c prefactor, exponent, x-polynomial,
-  ln c²_c prefactor, x-polynomial, ln of the sharpness k.
+  n-polynomial, ln c²_c prefactor, x-polynomial, n-polynomial, z-polynomials, ln of the
+  sharpness k; optionally x·n terms of both limits (``n_collapse_xnH``, ``n_collapse_xnc``)
+  and a separate sharpness k_c and offset s of the c² weight (``c2_sharpness``, ``c2_offset``).
 """
 
 from __future__ import annotations
@@ -55,6 +57,10 @@ class Form:
     n_collapse_nc: int = 1      # ... of c²_c
     n_collapse_zH: int = 1      # z_poly (curvature of the pressing surface) terms of H̄_c
     n_collapse_zc: int = 1      # ... of c²_c
+    n_collapse_xnH: int = 0     # xn_poly (x·n) terms of H̄_c
+    n_collapse_xnc: int = 0     # ... of c²_c
+    c2_sharpness: bool = False  # separate sharpness k_c of the c² weight
+    c2_offset: bool = False     # offset s of the c² weight, w_c = (r e^s)^k_c/(1 + (r e^s)^k_c)
     ratio: str = "a_over_R"     # finite-size ratio
     eps_lo: float = 0.01        # secant of the effective hardening exponent
     eps_hi: float = 0.1
@@ -90,6 +96,13 @@ class Form:
             p += [(f"Hc_z{k}", 0.0, -3.0, 3.0) for k in range(self.n_collapse_zH)]
             p += [(f"c2c_z{k}", 0.0, -3.0, 3.0) for k in range(self.n_collapse_zc)]
             p += [("ln_sharpness", math.log(2.0), math.log(0.5), math.log(30.0))]
+            p += [(f"Hc_xn{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_xnH)]
+            # like c²_c's x-polynomial: n Σ_k e_k (x − X_C2)^(k+1)
+            p += [(f"c2c_xn{k}", 0.0, -6.0, 6.0) for k in range(self.n_collapse_xnc)]
+            if self.c2_sharpness:
+                p += [("ln_sharpness_c2", math.log(2.0), math.log(0.5), math.log(30.0))]
+            if self.c2_offset:
+                p += [("offset_c2", 0.0, -3.0, 3.0)]
         return p
 
     @functools.cached_property
@@ -132,19 +145,31 @@ class Form:
             "references": {},
         }
         if self.collapse:
-            # ln c²_c = ln c0 + Σ_k d_k (x − X_C2)^(k+1), expanded in powers of x for the schema
+            # ln c²_c = ln c0 + Σ_k d_k (x − X_C2)^(k+1) + n Σ_k e_k (x − X_C2)^(k+1) + ...,
+            # expanded in powers of x for the schema (the n e(0) part joins exp_poly[0])
             shifted = _shift_powers(seq("c2c_x", self.n_collapse_c), X_C2)
+            c_n = seq("c2c_n", self.n_collapse_nc)
+            c_xn = []
+            if self.n_collapse_xnc:
+                sh = _shift_powers(seq("c2c_xn", self.n_collapse_xnc), X_C2)
+                c_n = [c_n[0] + sh[0]] + c_n[1:] if c_n else [sh[0]]
+                c_xn = [float(c) for c in sh[1:]]
             d["collapse"] = {
                 "H_bar": {"prefactor": math.exp(v["ln_Hc"]), "exponent": v["Hc_exponent"],
                           "x_poly": seq("Hc_x", self.n_collapse_H),
                           "exp_poly": seq("Hc_n", self.n_collapse_nH),
-                          "z_poly": seq("Hc_z", self.n_collapse_zH)},
+                          "z_poly": seq("Hc_z", self.n_collapse_zH),
+                          "xn_poly": seq("Hc_xn", self.n_collapse_xnH)},
                 "c2": {"prefactor": math.exp(v["ln_c2c"] + shifted[0]), "exponent": 0.0,
                        "x_poly": [float(c) for c in shifted[1:]],
-                       "exp_poly": seq("c2c_n", self.n_collapse_nc),
-                       "z_poly": seq("c2c_z", self.n_collapse_zc)},
+                       "exp_poly": c_n,
+                       "z_poly": seq("c2c_z", self.n_collapse_zc), "xn_poly": c_xn},
                 "sharpness": math.exp(v["ln_sharpness"]),
             }
+            if self.c2_sharpness:
+                d["collapse"]["sharpness_c2"] = math.exp(v["ln_sharpness_c2"])
+            if self.c2_offset:
+                d["collapse"]["offset_c2"] = v["offset_c2"]
         return d
 
     def coefficients(self, params) -> Coefficients:
@@ -162,7 +187,8 @@ class Form:
 
 def _limit(d: dict) -> CollapseLimit:
     return CollapseLimit(prefactor=d["prefactor"], exponent=d["exponent"], x_poly=tuple(d["x_poly"]),
-                         exp_poly=tuple(d["exp_poly"]), z_poly=tuple(d["z_poly"]))
+                         exp_poly=tuple(d["exp_poly"]), z_poly=tuple(d["z_poly"]),
+                         xn_poly=tuple(d["xn_poly"]))
 
 
 def _unchecked(d: dict) -> Coefficients:
@@ -181,6 +207,8 @@ def _unchecked(d: dict) -> Coefficients:
         collapse_H_bar=None if col is None else _limit(col["H_bar"]),
         collapse_c2=None if col is None else _limit(col["c2"]),
         collapse_sharpness=0.0 if col is None else col["sharpness"],
+        collapse_sharpness_c2=None if col is None else col.get("sharpness_c2"),
+        collapse_offset_c2=None if col is None else col.get("offset_c2"),
         level_II_smooth=lev2["smooth"], source=d["source"], schema_version=d["schema_version"])
 
 
@@ -267,7 +295,8 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
                      lambda: co.collapse_H_bar.log_and_slope(y, n_eff, z)[0])
         lncc = _memo(ds, "ln_c2c", (co.collapse_c2,) + where,
                      lambda: co.collapse_c2.log_and_slope(y, n_eff, z)[0])
-        H, c = levels.blend_from_logs(H, c, lnHc, lncc, co.collapse_sharpness)[:2]
+        H, c = levels.blend_from_logs(H, c, lnHc, lncc, co.collapse_sharpness,
+                                      co.collapse_sharpness_c2, co.collapse_offset_c2)[:2]
     p = H * np.where(elastic, 1.0, sig)
     if elastic.any():  # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor
         hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
@@ -326,6 +355,23 @@ FORMS: dict[str, Form] = {
                         "exponent the secant between ε_p = 0.03 and 0.3", smooth=True, n_shape_H=2,
                         n_shape_c=2, n_finite_H=2, n_finite_c=2, finite_by_level=True,
                         n_collapse_H=3, n_collapse_c=3, n_collapse_nH=2, eps_lo=0.03, eps_hi=0.3),
+    "smooth2_fs2_xn": Form("smooth2_fs2_xn", "as smooth2_fs2, both collapse limits with an "
+                           "a/R·n term", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
+                           n_finite_c=2, finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1),
+    "smooth2_fs2_xnw": Form("smooth2_fs2_xnw", "as smooth2_fs2_xn, c² collapse weight with its own "
+                            "sharpness and offset", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
+                            n_finite_c=2, finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
+                            c2_sharpness=True, c2_offset=True),
+    # the two parts of the xnw weight alone (``--forms``)
+    "smooth2_fs2_xnk": Form("smooth2_fs2_xnk", "as smooth2_fs2_xn, c² collapse weight with its own "
+                            "sharpness", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
+                            n_finite_c=2, finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
+                            c2_sharpness=True),
+    "smooth2_fs2_xns": Form("smooth2_fs2_xns", "as smooth2_fs2_xn, c² collapse weight with its own "
+                            "offset", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
+                            n_finite_c=2, finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
+                            c2_offset=True),
 }
 #: forms compared by cross-validation in every calibration
-CANDIDATES = ("seed", "poly", "smooth", "smooth2", "smooth2_fs", "smooth2_fs2", "smooth2_ld3")
+CANDIDATES = ("seed", "poly", "smooth", "smooth2", "smooth2_fs", "smooth2_fs2", "smooth2_ld3",
+              "smooth2_fs2_xn", "smooth2_fs2_xnw")

@@ -281,10 +281,16 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
         col = co["collapse"]
         for key, lab in (("H_bar", "collapse H̄_c"), ("c2", "collapse c²_c")):
             lim = col[key]
+            xn = f" + n Σ {_fmt(lim['xn_poly'])} x^k" if lim.get("xn_poly") else ""
             L.append(f"| {lab} | {_fmt(lim['prefactor'])} x^−{_fmt(lim['exponent'])} "
-                     f"exp(Σ {_fmt(lim['x_poly'])} x^k + Σ {_fmt(lim['exp_poly'])} n^k "
+                     f"exp(Σ {_fmt(lim['x_poly'])} x^k + Σ {_fmt(lim['exp_poly'])} n^k{xn} "
                      f"+ Σ {_fmt(lim['z_poly'])} z^k) |")
         L.append(f"| sharpness k | {_fmt(col['sharpness'])} |")
+        if "sharpness_c2" in col:
+            L.append(f"| sharpness k_c of the c² weight | {_fmt(col['sharpness_c2'])} |")
+        if "offset_c2" in col:
+            L.append(f"| offset s of the c² weight, w_c = (r e^s)^k_c/(1 + (r e^s)^k_c) | "
+                     f"{_fmt(col['offset_c2'])} |")
     he = co["hardening_exponent"]
     L.append(f"| effective exponent n | secant of ln σ_f vs ln ε_p between {he['eps_lo']:g} "
              f"and {he['eps_hi']:g} |")

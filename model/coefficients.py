@@ -24,12 +24,16 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
 * large-deformation collapse (schema 2, optional; same ratio x): the half-space values
   H̄_hs, c²_hs above are blended with limits of the whole body,
   L(x, n, z) = prefactor · x^(−exponent) · exp(Σ_k x_poly[k] x^(k+1) + Σ_k exp_poly[k] n^(k+1)
-  + Σ_k z_poly[k] z^(k+1)), z = R/ρ_H − 1 with ρ_H the body's Hertz relative radius
-  (a constant of the pair: 0 for equal spheres, R/R_i against a rigid sphere),
+  + n Σ_k xn_poly[k] x^(k+1) + Σ_k z_poly[k] z^(k+1)), z = R/ρ_H − 1 with ρ_H the body's
+  Hertz relative radius (a constant of the pair: 0 for equal spheres, R/R_i against a rigid
+  sphere); ``xn_poly`` (optional, default none) lets the x-dependence vary with n,
   r = H̄_hs/H̄_c,  w = r^k/(1 + r^k)  (k = sharpness),
+  w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c))  (the c² weight: k_c = sharpness_c2 and
+  s = offset_c2, both optional, default k and 0, so that w_c = w),
   H̄ = H̄_hs (1 + r^k)^(−1/k)   (smooth minimum of H̄_hs and H̄_c),
-  c² = c²_hs^(1−w) · c²_c^w;  H̄_c → ∞ as x → 0 (exponent > 0), so w → 0 and the
-  correction vanishes.
+  c² = c²_hs^(1−w_c) · c²_c^(w_c);  H̄_c → ∞ as x → 0 (exponent > 0), so w, w_c → 0 and
+  the correction vanishes. L depends on a only through x (n and z are constants of a
+  body and a pair), so p_m keeps rising with 1/ρ and the κ root stays unique.
 
 Schema 1 files (the literature set) are still read; they have no collapse block.
 
@@ -185,7 +189,8 @@ def _choice(d: dict, key: str, where: str, allowed: tuple[str, ...]) -> str:
 
 
 def _limit(d, where: str) -> CollapseLimit:
-    """A collapse limit {prefactor, exponent, x_poly, exp_poly} (see module docstring)."""
+    """A collapse limit {prefactor, exponent, x_poly, exp_poly, z_poly[, xn_poly]} (module
+    docstring); ``xn_poly`` is optional (absent: none)."""
     if not isinstance(d, dict):
         raise ValueError(f"coefficients: '{where}' must be an object, got {type(d).__name__}")
     pre = _number(d, "prefactor", where + ".")
@@ -194,7 +199,8 @@ def _limit(d, where: str) -> CollapseLimit:
     return CollapseLimit(prefactor=pre, exponent=_number(d, "exponent", where + "."),
                          x_poly=_poly(d, "x_poly", where + "."),
                          exp_poly=_poly(d, "exp_poly", where + "."),
-                         z_poly=_poly(d, "z_poly", where + "."))
+                         z_poly=_poly(d, "z_poly", where + "."),
+                         xn_poly=_poly(d, "xn_poly", where + ".") if "xn_poly" in d else ())
 
 
 def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
@@ -219,7 +225,8 @@ def _poly_and_slope(x, poly: tuple[float, ...]):
 @dataclass(frozen=True)
 class CollapseLimit:
     """L(x, n, z) = prefactor · x^(−exponent)
-    · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1) + Σ z_poly[k] z^(k+1)).
+    · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1) + n Σ xn_poly[k] x^(k+1)
+    + Σ z_poly[k] z^(k+1)).
 
     x: finite-size ratio, n: effective hardening exponent, z = R/ρ_H − 1: curvature of the
     surface pressing the body relative to the body's own, with ρ_H the Hertz relative
@@ -231,12 +238,18 @@ class CollapseLimit:
     x_poly: tuple[float, ...] = ()
     exp_poly: tuple[float, ...] = ()
     z_poly: tuple[float, ...] = ()
+    xn_poly: tuple[float, ...] = ()
 
     def log_and_slope(self, x, n=0.0, z=0.0):
-        """ln L, d ln L/d ln x and d ln L/d z, vectorised (x > 0)."""
+        """ln L, d ln L/d ln x = −exponent + Σ (k+1) x_poly[k] x^(k+1)
+        + n Σ (k+1) xn_poly[k] x^(k+1) and d ln L/d z, vectorised (x > 0)."""
         x = np.asarray(x, dtype=float)
         z = np.asarray(z, dtype=float)
         s, ds = _poly_and_slope(x, self.x_poly)
+        if self.xn_poly:
+            sn, dsn = _poly_and_slope(x, self.xn_poly)
+            n_ = np.asarray(n, dtype=float)
+            s, ds = s + n_ * sn, ds + n_ * dsn
         sz = np.zeros_like(z)  # Σ c_k z^(k+1)
         dz = np.zeros_like(z)  # Σ (k+1) c_k z^k
         for k in range(len(self.z_poly) - 1, -1, -1):
@@ -253,7 +266,7 @@ class CollapseLimit:
     def to_dict(self) -> dict:
         return {"prefactor": self.prefactor, "exponent": self.exponent,
                 "x_poly": list(self.x_poly), "exp_poly": list(self.exp_poly),
-                "z_poly": list(self.z_poly)}
+                "z_poly": list(self.z_poly), "xn_poly": list(self.xn_poly)}
 
 
 @dataclass(frozen=True)
@@ -280,6 +293,8 @@ class Coefficients:
     collapse_H_bar: CollapseLimit | None = None
     collapse_c2: CollapseLimit | None = None
     collapse_sharpness: float = 0.0
+    collapse_sharpness_c2: float | None = None  # None: the same as collapse_sharpness
+    collapse_offset_c2: float | None = None     # None: 0
     level_II_smooth: bool = False
     source: str = "literature"
     schema_version: int = SCHEMA_VERSION
@@ -335,7 +350,7 @@ class Coefficients:
         refs = d.get("references", {})
         if not isinstance(refs, dict):
             raise ValueError("coefficients: 'references' must be an object")
-        cH = cc = None
+        cH = cc = kc = sc = None
         k = 0.0
         smooth = False
         fsHp = fscp = None
@@ -365,6 +380,13 @@ class Coefficients:
                 k = _number(col, "sharpness", "collapse.")
                 if k <= 0.0:
                     raise ValueError(f"coefficients: 'collapse.sharpness' must be > 0, got {k!r}")
+                if "sharpness_c2" in col:
+                    kc = _number(col, "sharpness_c2", "collapse.")
+                    if kc <= 0.0:
+                        raise ValueError(f"coefficients: 'collapse.sharpness_c2' must be > 0, "
+                                         f"got {kc!r}")
+                if "offset_c2" in col:
+                    sc = _number(col, "offset_c2", "collapse.")
                 if cH.exponent <= 0.0:
                     raise ValueError("coefficients: 'collapse.H_bar.exponent' must be > 0 (the limit "
                                      f"must vanish as the ratio -> 0), got {cH.exponent!r}")
@@ -394,6 +416,8 @@ class Coefficients:
             collapse_H_bar=cH,
             collapse_c2=cc,
             collapse_sharpness=k,
+            collapse_sharpness_c2=kc,
+            collapse_offset_c2=sc,
             level_II_smooth=smooth,
             source=source,
             schema_version=version,
@@ -426,6 +450,10 @@ class Coefficients:
             d["collapse"] = None if not self.has_collapse else {
                 "H_bar": self.collapse_H_bar.to_dict(), "c2": self.collapse_c2.to_dict(),
                 "sharpness": self.collapse_sharpness}
+            if self.has_collapse and self.collapse_sharpness_c2 is not None:
+                d["collapse"]["sharpness_c2"] = self.collapse_sharpness_c2
+            if self.has_collapse and self.collapse_offset_c2 is not None:
+                d["collapse"]["offset_c2"] = self.collapse_offset_c2
         d["references"] = copy.deepcopy(self.references)
         return d
 
@@ -488,6 +516,12 @@ class Coefficients:
     @property
     def has_collapse(self) -> bool:
         return self.collapse_H_bar is not None
+
+    @property
+    def c2_sharpness(self) -> float:
+        """Sharpness k_c of the c² collapse weight: ``collapse_sharpness_c2``, else k."""
+        kc = self.collapse_sharpness_c2
+        return self.collapse_sharpness if kc is None else kc
 
 
 def default_path() -> Path:

@@ -16,7 +16,9 @@ coefficients move from Level I to Level III values with the level weight s = 3t�
 The large-deformation collapse (:func:`collapse_blend`) then blends these half-space
 values with the whole-body limits H̄_c(x, n), c²_c(x, n):
 
-    r = H̄_hs/H̄_c,  w = r^k/(1 + r^k),  H̄ = H̄_hs (1 + r^k)^(−1/k),  c² = c²_hs^(1−w) c²_c^w.
+    r = H̄_hs/H̄_c,  w = r^k/(1 + r^k),  H̄ = H̄_hs (1 + r^k)^(−1/k),
+    w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c)),  c² = c²_hs^(1−w_c) c²_c^(w_c)
+    (k_c = k and s = 0, i.e. w_c = w, unless set).
 """
 
 from __future__ import annotations
@@ -177,12 +179,13 @@ class CollapseBlend(NamedTuple):
 
     H_bar: np.ndarray        # blended H̄
     c2: np.ndarray           # blended c²
-    w: np.ndarray            # collapse weight w ∈ [0, 1)
+    w: np.ndarray            # collapse weight w ∈ [0, 1) of H̄ (sharpness k)
     dlnHc_dlnx: np.ndarray   # d ln H̄_c/d ln x
     lnc2_gap: np.ndarray     # ln c²_c − ln c²_hs
     dlnc2c_dlnx: np.ndarray  # d ln c²_c/d ln x
     dlnHc_dz: np.ndarray     # d ln H̄_c/d z
     dlnc2c_dz: np.ndarray    # d ln c²_c/d z
+    w_c2: np.ndarray         # collapse weight w_c of c² (sharpness k_c)
 
 
 def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> CollapseBlend:
@@ -199,34 +202,43 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
 
     Log derivatives of the result follow from those of the inputs:
     d ln H̄ = (1 − w) d ln H̄_hs + w d ln H̄_c and
-    d ln c² = (1 − w) d ln c²_hs + w d ln c²_c + (ln c²_c − ln c²_hs) dw,
-    dw = k w (1 − w) (d ln H̄_hs − d ln H̄_c).
+    d ln c² = (1 − w_c) d ln c²_hs + w_c d ln c²_c + (ln c²_c − ln c²_hs) dw_c,
+    dw_c = k_c w_c (1 − w_c) (d ln H̄_hs − d ln H̄_c).
     """
     H_hs, c2_hs, x, n, z = np.broadcast_arrays(
         *(np.asarray(v, dtype=float) for v in (H_hs, c2_hs, x, n, z)))
     zero = np.zeros_like(H_hs)
     if not coeffs.has_collapse:
-        return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero, zero, zero)
-    k = coeffs.collapse_sharpness
+        return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero, zero, zero, zero)
     lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, z)
     lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, z)
-    H, c, w, gap = blend_from_logs(H_hs, c2_hs, lnHc, lncc, k)
-    return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero)
+    H, c, w, gap, wc = blend_from_logs(H_hs, c2_hs, lnHc, lncc, coeffs.collapse_sharpness,
+                                       coeffs.collapse_sharpness_c2, coeffs.collapse_offset_c2)
+    return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero, wc)
 
 
-def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float):
-    """The blend of :func:`collapse_blend` from the limits' logarithms ln H̄_c, ln c²_c and the
-    sharpness k: returns H̄, c², the weight w = r^k/(1 + r^k) (r = H_hs/H̄_c) and
-    ln c²_c − ln c²_hs (0 where w = 0)."""
+def _weight(z):
+    """w = e^z/(1 + e^z) and ln(1 + e^z), without overflow."""
+    w = np.where(z > 0.0, 1.0 / (1.0 + np.exp(-z)), np.exp(z) / (1.0 + np.exp(z)))
+    return w, np.where(z > 0.0, z + np.log1p(np.exp(-z)), np.log1p(np.exp(z)))
+
+
+def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
+                    s_c: float | None = None):
+    """The blend of :func:`collapse_blend` from the limits' logarithms ln H̄_c, ln c²_c, the
+    sharpnesses k (H̄) and k_c (c²; None: k) and the offset s_c of the c² weight (None: 0):
+    returns H̄, c², the weight w = r^k/(1 + r^k) (r = H_hs/H̄_c), ln c²_c − ln c²_hs (0 where
+    w = w_c = 0) and w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c))."""
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
-        # w = r^k/(1 + r^k) and ln(1 + r^k), without overflow
-        z = k * lnr
-        w = np.where(z > 0.0, 1.0 / (1.0 + np.exp(-z)), np.exp(z) / (1.0 + np.exp(z)))
-        log1p = np.where(z > 0.0, z + np.log1p(np.exp(-z)), np.log1p(np.exp(z)))
+        w, log1p = _weight(k * lnr)
+        if (k_c is None or k_c == k) and not s_c:
+            wc = w
+        else:
+            wc = _weight((k if k_c is None else k_c) * (lnr + (s_c or 0.0)))[0]
         H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
-        gap = np.where(w > 0.0, lncc - np.log(c2_hs), 0.0)
-        return H, c2_hs * np.exp(w * gap), w, gap
+        gap = np.where((w > 0.0) | (wc > 0.0), lncc - np.log(c2_hs), 0.0)
+        return H, c2_hs * np.exp(wc * gap), w, gap, wc
 
 
 def level_weight(Lambda, coeffs: Coefficients):

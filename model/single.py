@@ -16,11 +16,12 @@ level weight enters d/d ln Λ; y is the finite-size ratio).
 
 With a collapse block (``levels.collapse_blend``; y = finite-size ratio, n = effective
 exponent), the half-space p_hs = H̄_hs σ_rep and c²_hs are blended with the whole-body
-limits: ln r = ln p_hs − ln σ_rep − ln H̄_c(y, z), w = r^k/(1 + r^k),
-p_m = p_hs (1 + r^k)^(−1/k), c² = c²_hs^(1−w) c²_c(y, z)^w, and
+limits: ln r = ln p_hs − ln σ_rep − ln H̄_c(y, n, z), w = r^k/(1 + r^k),
+w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c)) (s constant), p_m = p_hs (1 + r^k)^(−1/k),
+c² = c²_hs^(1−w_c) c²_c(y, n, z)^(w_c), and
 
     ∂ln p_m = (1 − w) ∂ln p_hs + w (∂ln σ_rep + ∂ln H̄_c),
-    ∂ln c²  = (1 − w) ∂ln c²_hs + w ∂ln c²_c + (ln c²_c − ln c²_hs) k w (1 − w) ∂ln r.
+    ∂ln c²  = (1 − w_c) ∂ln c²_hs + w_c ∂ln c²_c + (ln c²_c − ln c²_hs) k_c w_c (1 − w_c) ∂ln r.
 
 z is the curvature ratio R/ρ_H − 1 of the body with ρ_H its Hertz (Level I) relative
 radius, a constant of the pair (:func:`curvature_ratio`): 0 for equal spheres (flat
@@ -167,12 +168,13 @@ class BodyLaw:
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
         if co.has_collapse and not math.isinf(mat.sigma_y):
             b = collapse_blend(p / sig, c, y, co, self.n_eff, z)
-            w, v = b.w, co.collapse_sharpness * b.w * (1.0 - b.w) * b.lnc2_gap
+            w, wc = b.w, b.w_c2
+            v = co.c2_sharpness * wc * (1.0 - wc) * b.lnc2_gap
             dr_x, dr_y = dp_x - m, dp_y - b.dlnHc_dlnx  # ∂ln r
             p = b.H_bar * sig
             dp_x, dp_y = (1.0 - w) * dp_x + w * m, (1.0 - w) * dp_y + w * b.dlnHc_dlnx
-            dc_x = (1.0 - w) * dc_x + v * dr_x
-            dc_y = (1.0 - w) * dc_y + w * b.dlnc2c_dlnx + v * dr_y
+            dc_x = (1.0 - wc) * dc_x + v * dr_x
+            dc_y = (1.0 - wc) * dc_y + wc * b.dlnc2c_dlnx + v * dr_y
             c = b.c2
         return BodyResponse(
             p_m=p, c2=c, Lambda=Lam, sigma_rep=sig,
