@@ -150,7 +150,8 @@ class CalibratedRange:
                  else "default: the campaign's calibration design")
         return (f"E/σ_Y {self.E_over_sigma_y[0]:g}–{self.E_over_sigma_y[1]:g}, ν {self.nu[0]:g}–"
                 f"{self.nu[1]:g}, hardening exponent n {self.hardening_n[0]:g}–{self.hardening_n[1]:g}, "
-                f"h/R ≤ {self.h_over_R_max:g} (each sphere's own approach), a/R ≤ {self.a_over_R_max:g}{lam}; pairs: radius ratio ≤ "
+                f"h/R ≤ {self.h_over_R_max:g} (each sphere's own approach), a/R ≤ {self.a_over_R_max:g}"
+                f"{lam}; pairs: radius ratio ≤ "
                 f"{self.radius_ratio_max:g}, yield ratio ≤ {self.yield_ratio_max:g}, E ratio ≤ "
                 f"{self.E_ratio_max:g} ({where})")
 
