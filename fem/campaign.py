@@ -24,7 +24,9 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import json
+import math
 import os
+import shutil
 import sys
 import time
 import traceback as _traceback
@@ -61,11 +63,46 @@ class Outcome:
     traceback: str = ""
 
 
+#: environment variable naming the directory where local workers report each run's progress
+PROGRESS_ENV = "SPHERECONTACT_CAMPAIGN_PROGRESS"
+
+
+def _progress_writer(case: Case, kwargs: dict):
+    """progress(h) writing h/h_max of ``case`` to ``$PROGRESS_ENV/<key>`` (at most every 2 s,
+    replaced atomically), or None when the variable is not set."""
+    folder = os.environ.get(PROGRESS_ENV)
+    if not folder:
+        return None
+    path, h_max, last = Path(folder) / case.key, kwargs["h_max"], [-math.inf]
+
+    def progress(h: float) -> None:
+        now = time.monotonic()
+        if now - last[0] >= 2.0:
+            last[0] = now
+            tmp = path.with_suffix(".tmp")
+            tmp.write_text(f"{h / h_max:.6g}")
+            tmp.replace(path)
+    return progress
+
+
+def read_progress(folder: Path, cases) -> dict[str, float]:
+    """case name → reported fraction h/h_max of the running ``cases`` that reported one."""
+    out = {}
+    for case in cases:
+        try:
+            out[case.name] = float((Path(folder) / case.key).read_text())
+        except (OSError, ValueError):
+            continue
+    return out
+
+
 def execute(case: Case) -> Outcome:
-    """Run one case (in a worker); every exception becomes a failed Outcome."""
+    """Run one case (in a worker); every exception becomes a failed Outcome. Local workers
+    report the run's progress when :data:`PROGRESS_ENV` is set."""
     t0 = time.perf_counter()
     try:
-        result = run_indentation(**case.run_kwargs())
+        kwargs = case.run_kwargs()
+        result = run_indentation(**kwargs, progress=_progress_writer(case, kwargs))
         prov = provenance(result, extra={"entry_point": ENTRY_POINT, "set": case.set,
                                          "case": case.name})
         return Outcome(case.key, result.status, result.reason,
@@ -91,21 +128,31 @@ def _inline(cases: list[Case], runner: Runner) -> Iterator[tuple[Case, Outcome]]
         yield case, runner(case)
 
 
-def _local(cases: list[Case], runner: Runner, workers: int) -> Iterator[tuple[Case, Outcome]]:
-    """Local worker processes (spawned, one numerical thread each); results as they finish."""
-    saved = {v: os.environ.get(v) for v in THREAD_VARS}
-    os.environ.update({v: "1" for v in THREAD_VARS})  # inherited by the spawned workers
+def _local(cases: list[Case], runner: Runner, workers: int, progress_dir: Path | None = None,
+           on_wait: Callable[[list[Case]], None] | None = None) -> Iterator[tuple[Case, Outcome]]:
+    """Local worker processes (spawned, one numerical thread each); results as they finish.
+    With ``progress_dir`` the workers report their runs' progress there, and ``on_wait(running)``
+    is called every few seconds while no run finishes."""
+    env = {v: "1" for v in THREAD_VARS}
+    if progress_dir is not None:
+        env[PROGRESS_ENV] = str(progress_dir)
+    saved = {v: os.environ.get(v) for v in env}
+    os.environ.update(env)  # inherited by the spawned workers
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"))
     try:
         pending = {pool.submit(runner, case): case for case in cases}
         while pending:
-            done, _ = wait(pending, return_when=FIRST_COMPLETED)
+            done, _ = wait(pending, timeout=5.0 if on_wait else None, return_when=FIRST_COMPLETED)
+            if not done and on_wait is not None:
+                on_wait([c for f, c in pending.items() if f.running()])
             for fut in done:
                 case = pending.pop(fut)
                 err = fut.exception()
                 yield case, (_lost(case, err) if err is not None else fut.result())
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+        if progress_dir is not None:
+            shutil.rmtree(progress_dir, ignore_errors=True)
         for var, value in saved.items():
             if value is None:
                 os.environ.pop(var, None)
@@ -226,6 +273,22 @@ def _log(bar, text: str) -> None:
         bar.write(text, file=sys.stderr)
 
 
+def _running_reporter(bar, folder: Path, every_s: float = 300.0):
+    """on_wait callback: the running cases' h/h_max in the bar's postfix (on a terminal), or a
+    log line every ``every_s`` seconds (otherwise)."""
+    last = [time.monotonic()]
+
+    def report(running: list[Case]) -> None:
+        frac = read_progress(folder, running)
+        text = ", ".join(f"{name} {100 * f:.0f} %" for name, f in frac.items())
+        if not bar.disable:
+            bar.set_postfix_str(text, refresh=True)
+        elif text and time.monotonic() - last[0] >= every_s:
+            last[0] = time.monotonic()
+            print(f"running: {text} of h_max", file=sys.stderr, flush=True)
+    return report
+
+
 def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = None,
                  workers: int | None = None, scheduler: str | None = None,
                  retry_failed: bool = False, retry_stopped: bool = False,
@@ -252,14 +315,17 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
           f"{len(todo)} to run on {backend}", file=sys.stderr, flush=True)
     t0 = time.perf_counter()
     if todo:
+        bar = tqdm(total=len(todo), unit="run", desc="fem campaign", file=sys.stderr,
+                   disable=not sys.stderr.isatty(), smoothing=0.1)
         if scheduler:
             stream = _dask(todo, runner, scheduler)
         elif workers == 0:
             stream = _inline(todo, runner)
-        else:
-            stream = _local(todo, runner, min(workers, len(todo)))
-        bar = tqdm(total=len(todo), unit="run", desc="fem campaign", file=sys.stderr,
-                   disable=not sys.stderr.isatty(), smoothing=0.1)
+        else:  # workers report their runs' h/h_max to a folder next to the database
+            folder = db_path.parent / f".{db_path.name}.progress"
+            folder.mkdir(exist_ok=True)
+            stream = _local(todo, runner, min(workers, len(todo)), folder,
+                            _running_reporter(bar, folder))
         try:
             for done, (case, out) in enumerate(stream, start=1):
                 present = _state(db, case.key)

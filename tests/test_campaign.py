@@ -230,6 +230,27 @@ def test_superseded_entries_are_listed_and_pruned(tmp_path, capsys):
     assert len(db) == 0 and db.failed() == [] and fc.superseded(changed, db) == []
 
 
+def test_workers_report_progress_and_the_folder_is_removed(tmp_path, monkeypatch):
+    c = parse_campaign(tiny('[[calibration]]\nscene = "flat"\nE_over_sigma_y = [100, 200]\n'))
+    folder = tmp_path / "progress"
+    folder.mkdir()
+    monkeypatch.setenv(fc.PROGRESS_ENV, str(folder))
+    case = c.cases[0]
+    assert fc.execute(case).status == "converged"
+    (frac,) = fc.read_progress(folder, c.cases).values()    # the case that ran, not the other
+    assert 0.0 < frac <= 1.0 + 1e-12
+    monkeypatch.delenv(fc.PROGRESS_ENV)
+    db_path = tmp_path / "ref.h5"
+    seen = []
+    (tmp_path / "p2").mkdir()
+    stream = fc._local(c.cases, fc.execute, 1, tmp_path / "p2", seen.append)
+    assert sorted(o.status for _, o in stream) == ["converged", "converged"]
+    assert not (tmp_path / "p2").exists()                    # removed when the workers are done
+    assert all(isinstance(running, list) for running in seen)
+    assert fc.run_campaign(c, db_path, workers=1)["total"]["converged"] == 2
+    assert not (tmp_path / ".ref.h5.progress").exists()
+
+
 def test_remove_entries_rejects_unknown_keys_and_keeps_the_rest(tmp_path):
     from spherecontact.data import remove_entries
     c = parse_campaign(tiny('[[calibration]]\nscene = "flat"\nE_over_sigma_y = [100, 200]\n'))
