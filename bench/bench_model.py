@@ -31,6 +31,10 @@ from spherecontact.model.range_check import range_check  # noqa: E402
 from spherecontact.model.unified import pair as unified_pair  # noqa: E402
 from spherecontact.validation.peers import jackson_green  # noqa: E402
 
+# the steel–aluminium pair (yield ratio 4) lies outside the calibrated pair range (3): it is
+# here for its cost, a realistic engineering pair, not its accuracy
+warnings.filterwarnings("ignore", category=CalibrationRangeWarning)
+
 N = 1_000_000
 REPEAT = 5
 R = 1e-3
