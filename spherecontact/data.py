@@ -456,20 +456,27 @@ def remove_entries(path, keys) -> list[Record]:
         if not keys:
             return []
         removed = [db.record(k) for k in keys]
-        tmp = _temporary_sibling(path)
-        try:
+        with _replacing(path) as tmp:
             _copy_without(path, tmp, [f"{FAILED if r.status == 'failed' else RUNS}/{r.key}"
                                       for r in removed])
             with h5py.File(tmp, "a") as f:
                 f.attrs["modified"] = _utc_now()
-                f.flush()
-            _fsync(tmp)
-            os.replace(tmp, path)
-            _fsync(path.parent)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
     return removed
+
+
+@contextmanager
+def _replacing(path: Path):
+    """Yield a temporary sibling of ``path`` to write; on success it is fsynced and renamed
+    over ``path`` (atomic), on any exception deleted, leaving ``path`` as it was."""
+    tmp = _temporary_sibling(path)
+    try:
+        yield tmp
+        _fsync(tmp)
+        os.replace(tmp, path)
+        _fsync(path.parent)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def append_run(path, record: Record, result: RunResult | None, prov: dict | None = None, *,
@@ -500,8 +507,7 @@ def append_run(path, record: Record, result: RunResult | None, prov: dict | None
         if present is not None and present.status != "failed" and not replace:
             raise ValueError(f"{path}: key {record.key} ({present.case}) is already present "
                              f"with status {present.status!r}")
-        tmp = _temporary_sibling(path)
-        try:
+        with _replacing(path) as tmp:
             if present is not None and present.status != "failed":
                 _copy_without(path, tmp, f"{RUNS}/{record.key}")
             elif path.exists():
@@ -518,13 +524,6 @@ def append_run(path, record: Record, result: RunResult | None, prov: dict | None
                     f.attrs["campaign_sha256"] = hashlib.sha256(campaign_text.encode()).hexdigest()
                     f.attrs["campaign_source"] = str(campaign_source)
                 f.attrs["modified"] = _utc_now()
-                f.flush()
-            _fsync(tmp)
-            os.replace(tmp, path)
-            _fsync(path.parent)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
 
 
 def remove_stale_temporaries(path) -> list[Path]:
