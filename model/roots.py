@@ -3,8 +3,11 @@
 One root per array element, all solved together: no Python loop over elements,
 only over iterations (each iteration evaluates f on the still-active elements).
 Newton steps are accepted inside the current bracket; otherwise the bracket is
-bisected, or — while one side of the bracket is still unknown — expanded by
-doubling steps towards the root. Every evaluation tightens the bracket.
+closed by a false-position step with the Illinois modification (Dowell & Jarratt
+1971: the stored end value that is kept twice in a row is halved, which makes the
+step superlinear also where f has a kink, e.g. at a level boundary), or — while one
+side of the bracket is still unknown — expanded by doubling steps towards the root.
+Every evaluation tightens the bracket.
 """
 
 from __future__ import annotations
@@ -44,6 +47,9 @@ def solve_increasing(
     n = x.size
     lo = np.full(n, -np.inf)
     hi = np.full(n, np.inf)
+    f_lo = np.full(n, np.nan)  # f at the bracket ends (Illinois-scaled)
+    f_hi = np.full(n, np.nan)
+    side = np.zeros(n, dtype=np.int8)  # end moved last: +1 hi, -1 lo
     width = np.full(n, step)
     idx = np.arange(n)
     fx, dx = f(x, idx)
@@ -53,8 +59,13 @@ def solve_increasing(
         xi = x[idx]
         done = fx == 0.0
         pos = fx > 0.0
+        neg = ~pos & ~done
         hi[idx] = np.where(pos, xi, hi[idx])
-        lo[idx] = np.where(~pos & ~done, xi, lo[idx])
+        lo[idx] = np.where(neg, xi, lo[idx])
+        s_old = side[idx]
+        f_lo[idx] = np.where(neg, fx, np.where(pos & (s_old == 1), 0.5 * f_lo[idx], f_lo[idx]))
+        f_hi[idx] = np.where(pos, fx, np.where(neg & (s_old == -1), 0.5 * f_hi[idx], f_hi[idx]))
+        side[idx] = np.where(pos, 1, np.where(neg, -1, s_old))
         l, h = lo[idx], hi[idx]
         with np.errstate(divide="ignore", invalid="ignore"):
             newton = xi - fx / dx
@@ -65,9 +76,12 @@ def solve_increasing(
         w = width[idx]
         expand_down = ~np.isfinite(l)
         expand_up = ~np.isfinite(h)
-        with np.errstate(invalid="ignore"):
-            mid = 0.5 * (l + h)
-        xn = np.where(ok, newton, np.where(expand_down, xi - w, np.where(expand_up, xi + w, mid)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            fl, fh = f_lo[idx], f_hi[idx]
+            regula = l - fl * (h - l) / (fh - fl)
+            inside = np.isfinite(regula) & (regula > l) & (regula < h)
+            closing = np.where(inside, regula, 0.5 * (l + h))
+        xn = np.where(ok, newton, np.where(expand_down, xi - w, np.where(expand_up, xi + w, closing)))
         width[idx] = np.where(~ok & (expand_down | expand_up), 2.0 * w, w)
         conv = done | (np.abs(xn - xi) <= tol * np.maximum(1.0, np.abs(xi)))
         x[idx] = np.where(done, xi, xn)
