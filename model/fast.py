@@ -302,8 +302,9 @@ class ContactLaw:
         for key, (run, t) in self._pending.items():
             if hi <= t:
                 continue
-            v = hi * self._ratio_at(run, hi) if key == "h_over_R" else \
-                float(np.interp(math.log(hi), self._s, run))
+            v = self._ratio_at(run, hi)
+            if key == "h_over_R":
+                v *= hi  # run holds h_i/R_i over h
             if v > chk.limits[key]:
                 out[key] = v
         return out
