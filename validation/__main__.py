@@ -31,6 +31,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--studies-fallback", default="reports/fem",
                    help="directory of FE verification runs (run_*.json) used for the studies when "
                         "the database has no studies set ('' to disable)")
+    p.add_argument("--mdr", default="data/peers/mdr.json",
+                   help="stored LAMMPS mdr curves (JSON; a missing file leaves mdr out)")
     p.add_argument("--study-runs", default="reports/validation/studies",
                    help="directory of the validation's own study runs (*.json), used with the fallback")
     return p
@@ -63,6 +65,11 @@ def main(argv: list[str] | None = None) -> int:
                               f"`{args.study_runs}/*.json` (the database has no `{args.studies_set}` "
                               "set)")
         records = load_records(db, args.set)
+        mdr = None
+        if args.mdr and Path(args.mdr).is_file():
+            from .mdr import load_store
+
+            mdr = load_store(args.mdr)
     except (OSError, ValueError) as err:
         print(f"validation: {err}", file=sys.stderr)
         return 2
@@ -71,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     res = build_report(validation, studies, coeffs, th, args.out, source=str(db),
                        coeff_path=args.coefficients or "model default", th_path=args.thresholds,
                        skipped=skipped,
-                       studies_source=studies_source)
+                       studies_source=studies_source, mdr=mdr, mdr_source=args.mdr)
     dt = time.perf_counter() - t0
     print(f"validation: {len(res.comparisons)} runs, report {res.path} ({len(res.pngs)} charts), "
           f"{dt:.1f} s")

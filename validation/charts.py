@@ -25,7 +25,10 @@ PEER_STYLE = {
     "Thornton 1997": ("C4", (0, (1, 1))),
     "Johnson cavity": ("C5", (0, (3, 1, 1, 1))),
     "Biwa–Storåkers 1995": ("C6", (0, (6, 2, 1, 2))),
+    "LAMMPS mdr": ("C9", "-"),
 }
+#: line width of a peer in the curve charts (default 1.1): the DEM law users run is drawn bolder
+PEER_WIDTH = {"LAMMPS mdr": 1.6}
 
 
 def pyplot():
@@ -91,9 +94,10 @@ def curves_chart(comp: Comparison, th: Thresholds, out: Path) -> Path:
             if not me.applies or pred is None:
                 continue
             color, ls = PEER_STYLE[name]
+            lw = PEER_WIDTH.get(name, 1.1)
             mask = ok if me.mask is None else ok & me.mask
-            top[q].plot(hR[mask], pred[mask], color=color, ls=ls, lw=1.1, label=name)
-            bottom[q].plot(hR[mask], 100 * me.errors[q][mask], color=color, ls=ls, lw=1.0,
+            top[q].plot(hR[mask], pred[mask], color=color, ls=ls, lw=lw, label=name)
+            bottom[q].plot(hR[mask], 100 * me.errors[q][mask], color=color, ls=ls, lw=lw - 0.1,
                            label=name)
         inside = ok & (hR >= x_lo)
         top[q].set_ylim(0.7 * np.nanmin(fe[inside]), 1.6 * np.nanmax(fe[inside]))

@@ -124,8 +124,9 @@ def model_curve_time(s1, s2, h, coeffs: Coefficients | None, repeats: int = 3) -
     return best
 
 
-def compare_case(case: Case, coeffs: Coefficients | None, th: Thresholds) -> Comparison:
-    """The model and the peers on one FE run (module docstring)."""
+def compare_case(case: Case, coeffs: Coefficients | None, th: Thresholds, mdr=None) -> Comparison:
+    """The model and the peers on one FE run (module docstring); ``mdr``: the stored LAMMPS
+    mdr curves (:func:`.mdr.load_store`, None: not given)."""
     s1, s2 = spheres(case)
     h = case.h
     R = reference_radius(case)
@@ -159,7 +160,7 @@ def compare_case(case: Case, coeffs: Coefficients | None, th: Thresholds) -> Com
     _errors_and_summaries(model, case, masks, labels, weights, resolved)
 
     peer_results = {}
-    for name, pred in predict_peers(case).items():
+    for name, pred in predict_peers(case, mdr).items():
         if isinstance(pred, NotApplicable):
             peer_results[name] = MethodErrors(name, False, pred.reason)
             continue

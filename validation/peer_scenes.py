@@ -22,6 +22,11 @@ approaches with the effective quantities their papers use:
   σ = σ_0 ε^n: perfect plasticity is n = 0; a Ludwik or tabulated curve is replaced by
   its secant power law through ε = 0.01 and 0.1. A pair of equal materials is two
   bodies each indented by h/2 at ρ = 2R*; dissimilar flow curves are outside it.
+* **LAMMPS mdr** (Zunker & Kamrin 2024, ``pair_style granular`` with the ``mdr`` normal
+  model) is not evaluated here but read from curves LAMMPS computed on the same scenes
+  (:mod:`.mdr`, ``data/peers/mdr.json``): the equal pair at δ = 2h for the flat scene,
+  the pair R1, R2 at δ = h for two bodies of one material. One elastic–perfectly plastic
+  material and no rigid body: rigid indenters, two materials and hardening are outside it.
 """
 
 from __future__ import annotations
@@ -34,12 +39,14 @@ import numpy as np
 from ..model import Material
 from . import peers
 from .cases import Case, is_perfectly_plastic, spheres
+from .mdr import NAME as MDR
+from .mdr import MdrStore, mdr_curve_at
 
 __all__ = ["PEERS", "PeerPrediction", "NotApplicable", "Equivalent", "equivalent", "predict_peers",
            "power_law_fit", "CAVITY_RANGE"]
 
 PEERS = ("Hertz", "Jackson–Green 2005", "Kogut–Etsion 2002", "Thornton 1997",
-         "Johnson cavity", "Biwa–Storåkers 1995")
+         "Johnson cavity", "Biwa–Storåkers 1995", MDR)
 
 #: range of Johnson's parameter E'a/(Yρ) where the cavity model is meant to hold
 CAVITY_RANGE = (3.0, 40.0)
@@ -103,8 +110,22 @@ def power_law_fit(m: Material) -> tuple[float, float]:
     return s_hi / hi**n, n
 
 
-def predict_peers(case: Case) -> dict:
-    """Every peer law on ``case``: name → :class:`PeerPrediction` or :class:`NotApplicable`."""
+def predict_peers(case: Case, mdr: MdrStore | None = None) -> dict:
+    """Every peer law on ``case``: name → :class:`PeerPrediction` or :class:`NotApplicable`.
+
+    ``mdr``: the stored LAMMPS mdr curves (:func:`.mdr.load_store`); None: mdr is not given.
+    """
+    out = _predict_laws(case)
+    got = mdr_curve_at(case, mdr)
+    if isinstance(got, str):
+        out[MDR] = NotApplicable(got)
+    else:
+        F, a, mask, note, _ = got
+        out[MDR] = PeerPrediction(F, a, mask=mask, note=note)
+    return out
+
+
+def _predict_laws(case: Case) -> dict:
     eq = equivalent(case)
     s1, s2 = spheres(case)
     deformable = [s.material for s in (s1, s2) if not s.is_rigid]
@@ -120,7 +141,8 @@ def predict_peers(case: Case) -> dict:
     if Y is None:
         reason = "no body can yield"
         for name in PEERS[1:]:
-            out[name] = NotApplicable(reason)
+            if name != MDR:
+                out[name] = NotApplicable(reason)
         return out
     yield_note = (f"S_y, ν of the body yielding first (σ_Y = {Y.sigma_y:g}, ν = {Y.nu:g})"
                   if two and not eq.equal_materials else "")

@@ -12,6 +12,7 @@ from .cases import Case
 from .charts import curves_chart, error_chart, representative
 from .compare import W_ACCEPT, Comparison, compare_case
 from .config import Thresholds
+from .mdr_report import mdr_section
 from .stability import (
     extreme_section,
     increment_section,
@@ -20,7 +21,7 @@ from .stability import (
     penalty_section,
     probes_section,
 )
-from .studies import reference, speed_accuracy, speed_accuracy_chart, speed_accuracy_table
+from .studies import mdr_points, reference, speed_accuracy, speed_accuracy_chart, speed_accuracy_table
 from .tables import class_matrix, class_tables, failures, level_table, pct, run_table
 
 __all__ = ["ReportResult", "build_report", "worst_point"]
@@ -75,19 +76,29 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
 def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficients | None,
                  th: Thresholds, out, *, source: str = "", coeff_path: str = "", th_path: str = "",
                  skipped: list[str] | None = None,
-                 studies_source: str = "") -> ReportResult:
-    """Compare every validation run, run the studies, write ``out/index.md`` and the PNGs."""
+                 studies_source: str = "", mdr=None, mdr_source: str = "") -> ReportResult:
+    """Compare every validation run, run the studies, write ``out/index.md`` and the PNGs.
+
+    ``mdr``: the stored LAMMPS mdr curves (:func:`.mdr.load_store`; None: mdr is not
+    given), read from ``mdr_source``.
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     for old in out.glob("*.png"):
         old.unlink()
     cf = default_coefficients() if coeffs is None else coeffs
-    comps = [compare_case(c, coeffs, th) for c in validation if c.h.size >= 2]
+    comps = [compare_case(c, coeffs, th, mdr) for c in validation if c.h.size >= 2]
     fails = failures(comps, th)
     pngs: list[Path] = []
     md = _header(source, cf, coeff_path, th, th_path, validation, studies, skipped or [])
     if studies_source:
         md.append(f"* Study runs (speed–accuracy, stability): {studies_source}.")
+    if mdr is not None:
+        md.append(f"* LAMMPS mdr: {len(mdr.curves)} stored curves `{mdr_source or mdr.path}` "
+                  f"(LAMMPS {mdr.version}; section \"LAMMPS mdr\").")
+    else:
+        md.append(f"* LAMMPS mdr: no stored curves (`{mdr_source or 'data/peers/mdr.json'}` not found; "
+                  "`make peers-mdr`).")
 
     # ------------------------------------------------------------------ verdict
     md += ["", "## Verdict", ""]
@@ -146,6 +157,11 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
             pngs.append(p)
             md += [f"![error vs {x}]({_rel(p, out)})", ""]
 
+    # ------------------------------------------------------------------ LAMMPS mdr
+    lines, mdr_pngs = mdr_section(comps, mdr, out, coeffs=coeffs, source=mdr_source)
+    md += lines
+    pngs += mdr_pngs
+
     # ------------------------------------------------------------------ speed–accuracy
     md += ["## Speed and accuracy", ""]
     base = reference(studies, th)
@@ -155,13 +171,16 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
     else:
         start = compare_case(base.base, coeffs, th).start
         ref, pts, models = speed_accuracy(studies, coeffs, th, start_h_over_R=start)
+        models += mdr_points(ref, mdr)
         p = speed_accuracy_chart(pts, models, out)
         pngs.append(p)
         md += [f"Standard case `{ref.base.label}`; reference: {ref.how}, smoothed by a local quadratic "
                "in ln h over 11 increments (FE scatter removed). Errors over h/R "
                f"{start:.2g}–{th.h_over_R_max:g} against that reference; time per curve: FE "
                "wall time of the run on one core, model: one evaluation of the whole curve on the "
-               "same approaches (best of three).", "", speed_accuracy_table(pts, models), "",
+               "same approaches (best of three); LAMMPS mdr: its stored run (many small steps), and its "
+               "cost per contact evaluation times the number of points.", "",
+               speed_accuracy_table(pts, models), "",
                f"![speed and accuracy]({_rel(p, out)})", ""]
 
     # ------------------------------------------------------------------ stability

@@ -15,7 +15,9 @@ to ``h_over_R_max``).
 **Cost.** FE: wall time of the run (one core; the solver is single-threaded), from the
 run's provenance. Model: the best of three wall times of one exact evaluation of the
 curve on the same grid (``contact``), and of building the tabulated law
-(``ContactLaw``) plus evaluating it on the grid.
+(``ContactLaw``) plus evaluating it on the grid. LAMMPS mdr (:func:`mdr_points`, from
+its stored curves): the wall time of its LAMMPS run, and its cost per contact
+evaluation times the number of points of the curve.
 """
 
 from __future__ import annotations
@@ -35,7 +37,8 @@ from .metrics import Summary, interp_loglog, relative_error, smooth_loglog, summ
 from .tables import markdown_table, pct
 
 __all__ = ["DEFAULTS", "variant", "Variant", "Reference", "standard_runs", "reference", "FEPoint",
-           "ModelPoint", "speed_accuracy", "speed_accuracy_chart", "speed_accuracy_table", "energy_balance"]
+           "ModelPoint", "speed_accuracy", "mdr_points", "speed_accuracy_chart", "speed_accuracy_table",
+           "energy_balance"]
 
 #: solver defaults of the standard case
 DEFAULTS = {"mesh_density": 1.0, "strain_increment": 0.005, "element": "q8r", "penalty": None}
@@ -175,6 +178,8 @@ class ModelPoint:
     time_s: float
     F: Summary
     a: Summary
+    color: str = "C3"
+    marker: str = ""     # "" : the next of the model's markers
 
 
 def _newton(case: Case) -> tuple[int, int]:
@@ -209,6 +214,31 @@ def speed_accuracy(cases: list[Case], coeffs: Coefficients | None, th: Threshold
               ModelPoint("model (tabulated ContactLaw, incl. setup)", t_table,
                          _against(ref, h, tab.F, "F"), _against(ref, h, tab.a, "a"))]
     return ref, pts, models
+
+
+def mdr_points(ref: Reference | None, store) -> list[ModelPoint]:
+    """LAMMPS mdr on the standard case against the reference (:mod:`.mdr`, stored curves).
+
+    Two times: the wall time of its stored LAMMPS run (an incremental law walks the whole
+    path in small steps), and its cost per contact evaluation (the store's lattice
+    benchmark) times the number of points of the reference curve — the basis of the
+    model's time per curve.
+    """
+    from .mdr import mdr_scene
+
+    if ref is None or store is None:
+        return []
+    scene = mdr_scene(ref.base)
+    c = store.find(scene) if isinstance(scene, dict) else None
+    if c is None:
+        return []
+    F, a = _against(ref, c.h, c.F, "F"), _against(ref, c.h, c.a, "a")
+    pts = [ModelPoint(f"LAMMPS mdr (its run: {c.steps:,} steps)", c.wall_s, F, a, "C9", "o")]
+    cost = store.doc.get("cost", {}).get("mdr", {}).get("s_per_contact")
+    if cost:
+        n = int(np.sum(ref.h > 0))
+        pts.append(ModelPoint(f"LAMMPS mdr ({n} contact evaluations)", cost * n, F, a, "C9", "^"))
+    return pts
 
 
 def _timed(fn) -> float:
@@ -260,10 +290,12 @@ def speed_accuracy_chart(pts: list[FEPoint], models: list[ModelPoint], out: Path
             if _is_default(p.variant, "mesh_density") and _is_default(p.variant, "strain_increment"):
                 axis.annotate("base", (p.time_s, max(100 * getattr(p, q).max, floor)), fontsize=7,
                               xytext=(-22, 6), textcoords="offset points")
-        for m, marker in zip(models, ("s", "D"), strict=False):
-            axis.plot([m.time_s], [max(100 * getattr(m, q).max, floor)], marker, color="C3",
+        default = iter(("s", "D", "p", "h"))
+        for m in models:
+            marker = m.marker or next(default)
+            axis.plot([m.time_s], [max(100 * getattr(m, q).max, floor)], marker, color=m.color,
                       ms=8 if marker == "s" else 6, label=f"{m.name}: max")
-            axis.plot([m.time_s], [max(100 * getattr(m, q).rms, floor)], marker, color="C3",
+            axis.plot([m.time_s], [max(100 * getattr(m, q).rms, floor)], marker, color=m.color,
                       mfc="none", ms=8 if marker == "s" else 6)
         axis.set_xscale("log")
         axis.set_yscale("log")
