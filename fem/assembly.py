@@ -75,6 +75,47 @@ class Discretisation:
         r, c = np.divmod(uniq, nd)
         self._indices = c.astype(np.int32)
         self._indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nd))]).astype(np.int32)
+        self._keys = uniq
+        self._rows, self._cols = r, c
+        # for every stored entry (i, j): the slots of the four entries of its node pair's 2×2 block
+        I, J = r // 2, c // 2
+        sib = np.stack([((2 * I + a) * nd + 2 * J + b) for a in range(2) for b in range(2)], axis=-1)
+        self._siblings = self.slots(sib // nd, sib % nd).reshape(-1, 2, 2)
+
+    def slots(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Positions in the CSR data array of entries (rows, cols) of the fixed pattern."""
+        keys = np.asarray(rows, dtype=np.int64) * self.n_dofs + np.asarray(cols, dtype=np.int64)
+        pos = np.searchsorted(self._keys, keys)
+        if np.any(pos >= self._keys.size) or np.any(self._keys[np.minimum(pos, self._keys.size - 1)] != keys):
+            raise ValueError("entry outside the sparsity pattern of the mesh")
+        return pos
+
+    def node_block_slots(self, nodes_i: np.ndarray, nodes_j: np.ndarray) -> np.ndarray:
+        """(n, 2, 2) data positions of the 2×2 blocks coupling nodes_i[k] with nodes_j[k]."""
+        ni = np.asarray(nodes_i)[:, None, None]
+        nj = np.asarray(nodes_j)[:, None, None]
+        a = np.arange(2)[None, :, None]
+        b = np.arange(2)[None, None, :]
+        return self.slots(2 * ni + a + 0 * b, 2 * nj + b + 0 * a)
+
+    def rotate_blocks(self, data: np.ndarray, Q: np.ndarray, rotated: np.ndarray) -> np.ndarray:
+        """Tangent data in nodal frames: K̃_IJ = Q_Iᵀ K_IJ Q_J for nodes with ``rotated[I]``.
+
+        ``Q``: (n_nodes, 2, 2) frames (identity elsewhere). The pattern is unchanged, so
+        the rotated matrix keeps the factorisation's symbolic analysis.
+        """
+        r, c = self._rows, self._cols
+        I, J = r // 2, c // 2
+        k = np.flatnonzero(rotated[I] | rotated[J])
+        qr = Q[I[k], :, r[k] % 2]  # (m, 2): column ci of Q_I
+        qc = Q[J[k], :, c[k] % 2]
+        out = data.copy()
+        out[k] = np.einsum("ka,kab,kb->k", qr, data[self._siblings[k]], qc)
+        return out
+
+    def matrix(self, data: np.ndarray) -> sp.csr_matrix:
+        """CSR matrix of the fixed pattern holding ``data``."""
+        return sp.csr_matrix((data, self._indices, self._indptr), shape=(self.n_dofs,) * 2)
 
     # ------------------------------------------------------------------ kinematics
     def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
@@ -102,7 +143,7 @@ class Discretisation:
         Bt = self.B.reshape(nel, nqp * 5, nb).transpose(0, 2, 1)
         Ke = np.matmul(Bt, AB.reshape(nel, nqp * 5, nb))
         data = np.bincount(self._slot, weights=Ke.ravel(), minlength=self._nnz)
-        return sp.csr_matrix((data, self._indices, self._indptr), shape=(self.n_dofs,) * 2)
+        return self.matrix(data)
 
     def integrate(self, values: np.ndarray) -> float:
         """∫ values dV₀ over the body (values at the points)."""

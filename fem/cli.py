@@ -106,11 +106,13 @@ def material2_from_args(args: argparse.Namespace, material: Material) -> Materia
 
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
     """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
-    --strain-increment, --max-wall-s, --no-line-search and --penalty."""
+    --strain-increment, --max-wall-s, --no-line-search, --penalty, --segment-points and
+    --linear-solver."""
     return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
                          max_iterations=args.max_iterations, tol=args.tol,
                          strain_increment=args.strain_increment, max_wall_s=args.max_wall_s,
-                         line_search=not args.no_line_search, penalty=args.penalty)
+                         line_search=not args.no_line_search, penalty=args.penalty,
+                         segment_points=args.segment_points, linear_solver=args.linear_solver)
 
 
 def _check_output(out) -> Path:
@@ -260,6 +262,12 @@ def _add_numerics(add) -> None:
         help="penalty contact with stiffness penalty * E / (pole element length), > 0 (two "
              "bodies: symmetric two-pass, with E* of the pair); the default is exact contact "
              "(Lagrange multipliers)")
+    add(grp, "--segment-points", type=int, default=0,
+        help="with --penalty (one body on a rigid flat or sphere): integrate the contact pressure "
+             "at this many Gauss points per surface edge, 1-64 (default 0: at the nodes)")
+    add(grp, "--linear-solver", choices=("ldl", "superlu"), default="ldl",
+        help="sparse factorisation: 'ldl' (qdldl LDL^T reusing its ordering, SuperLU where it "
+             "fails; default) or 'superlu'")
 
 
 def _add_output(add) -> None:

@@ -28,6 +28,11 @@ SIZE_POLE = 0.003  # within _POLE_DIST of the contact pole
 SIZE_ARC = 0.02  # along the whole arc
 SIZE_BULK = 0.10  # far from the arc
 _POLE_DIST = 0.07  # radius of the finest zone around the pole
+#: the optional surface band of ``build_mesh(edge_band=...)``: smallest size (units of the
+#: contact scale), growth of the size with depth below the arc, largest allowed ratio s/d
+EDGE_BAND_MIN = 0.0005
+EDGE_BAND_GRADING = 0.3
+EDGE_BAND_MAX = 0.2
 #: node order that reverses a quad's orientation, by nodes per element (corners, then midsides)
 REVERSED = {4: [0, 3, 2, 1], 8: [0, 3, 2, 1, 7, 6, 5, 4]}
 
@@ -52,6 +57,7 @@ class HemisphereMesh:
     equator: np.ndarray
     radius: float
     density: float
+    edge_band: float = 0.0
 
     @property
     def n_nodes(self) -> int:
@@ -70,8 +76,8 @@ def check_density(density: float) -> float:
     return d
 
 
-def _gmsh_quad8(radius: float, density: float, linear: bool,
-                contact_scale: float) -> tuple[np.ndarray, np.ndarray]:
+def _gmsh_quad8(radius: float, density: float, linear: bool, contact_scale: float,
+                edge_band: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Run gmsh; return node coordinates (2, n) and quad connectivity (n_per_el, n_el)."""
     import gmsh
 
@@ -121,6 +127,12 @@ def _gmsh_quad8(radius: float, density: float, linear: bool,
             near = field.add("Max")
             field.setNumbers(near, "FieldsList", [t_near, t_zone])
             fields.append(near)
+        if edge_band > 0:  # surface size proportional to the distance from the pole
+            band = field.add("MathEval")
+            smallest, ratio = EDGE_BAND_MIN * L / density, edge_band / density
+            expr = f"Max({smallest}, {ratio} * F{d_pole}) + {EDGE_BAND_GRADING} * F{d_arc}"
+            field.setString(band, "F", expr)
+            fields.append(band)
         both = field.add("Min")
         field.setNumbers(both, "FieldsList", fields)
         field.setAsBackgroundMesh(both)
@@ -157,7 +169,7 @@ def _gmsh_quad8(radius: float, density: float, linear: bool,
 
 
 def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
-               contact_scale: float | None = None) -> HemisphereMesh:
+               contact_scale: float | None = None, edge_band: float = 0.0) -> HemisphereMesh:
     """Graded all-quad meshing of the hemisphere's meridian section.
 
     Parameters
@@ -170,13 +182,20 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
         by a smaller partner of radius R₁ < R gets R₁ here: its contact zone is
         as small as the partner's, so it gets the partner's pole and arc sizes
         within about 1.2 R₁ of the pole, and its own coarser ones beyond.
+    edge_band : surface element size per unit distance from the pole, s = edge_band · d
+        (at least ``EDGE_BAND_MIN`` · contact_scale, growing by ``EDGE_BAND_GRADING`` per
+        unit depth below the arc); 0 (default) leaves the band out. Where the contact edge
+        travels, a node closing adds a ring of nearly full plastic pressure, a step of about
+        2 Δs/a in F: a constant s/d keeps that step the same fraction of F at every a.
     """
     radius = float(radius)
     if not np.isfinite(radius) or radius <= 0:
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
     density = check_density(density)
     scale = radius if contact_scale is None else min(float(contact_scale), radius)
-    Xg, tg = _gmsh_quad8(radius, density, linear, scale)
+    if not (np.isfinite(edge_band) and 0.0 <= edge_band <= EDGE_BAND_MAX):
+        raise ValueError(f"edge_band must lie in [0, {EDGE_BAND_MAX}] (0: off), got {edge_band!r}")
+    Xg, tg = _gmsh_quad8(radius, density, linear, scale, float(edge_band))
     if linear:
         mesh = skfem.MeshQuad1(Xg, tg)
         basis_mesh = mesh
@@ -201,4 +220,4 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
     axis = np.flatnonzero(np.abs(X[0]) < tol)
     equator = np.flatnonzero(np.abs(X[1] - radius) < tol)
     return HemisphereMesh(mesh=mesh, X=X, surface=surface, axis=axis, equator=equator,
-                          radius=radius, density=density)
+                          radius=radius, density=density, edge_band=float(edge_band))

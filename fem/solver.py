@@ -22,14 +22,14 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..model.material import Material
 from .assembly import Discretisation, positive_jacobian
 from .contact import RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
+from .linsolve import SymmetricSolver, constrain
 from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
+from .segment_penalty import SegmentPenalty
 
 #: nodal-force roundoff of the stress update, in units of E R² (see ``_newton``)
 ROUNDOFF = 1e-16
@@ -57,6 +57,11 @@ class SolverOptions:
     #: k_N = penalty · E / ℓ per unit reference area, ℓ the length of the pole's surface element
     #: (two bodies: E* of the pair, symmetric two-pass; twobody.py)
     penalty: float | None = None
+    #: "ldl": qdldl LDLᵀ reusing its symbolic analysis, SuperLU where it fails; "superlu": SuperLU only
+    linear_solver: str = "ldl"
+    #: 0: penalty at the nodes; n > 0: penalty pressure integrated at n Gauss points per surface
+    #: edge (segment_penalty.py), which needs ``penalty``
+    segment_points: int = 0
 
     def as_inputs(self) -> dict:
         """The options as stored with a run; None values are left out (HDF5 attributes have no
@@ -76,6 +81,13 @@ class SolverOptions:
             raise ValueError(f"growth must be >= 1, got {self.growth!r}")
         if not (isinstance(self.max_iterations, int) and 2 <= self.max_iterations <= 200):
             raise ValueError(f"max_iterations must be an integer in [2, 200], got {self.max_iterations!r}")
+        if not (isinstance(self.segment_points, int) and 0 <= self.segment_points <= 64):
+            raise ValueError(f"segment_points must be an integer in [0, 64] (0: nodal contact), "
+                             f"got {self.segment_points!r}")
+        if self.segment_points and self.penalty is None:
+            raise ValueError("segment_points > 0 needs penalty contact: set penalty (> 0) as well")
+        if self.linear_solver not in ("ldl", "superlu"):
+            raise ValueError(f"linear_solver must be 'ldl' or 'superlu', got {self.linear_solver!r}")
         if self.penalty is not None and not (isinstance(self.penalty, (int, float))
                                              and np.isfinite(self.penalty) and self.penalty > 0):
             raise ValueError(f"penalty must be None (exact contact) or a finite number > 0, "
@@ -206,7 +218,8 @@ class IndentationSolver:
     """Hemisphere (radius R, material) on a rigid obstacle; call ``run(h_max)``."""
 
     def __init__(self, material: Material, radius: float = 1.0, obstacle: RigidObstacle | None = None,
-                 density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None):
+                 density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None,
+                 edge_band: float = 0.0):
         if material.is_rigid:
             raise ValueError("the deformable body must not be rigid (E = inf)")
         self.material = material
@@ -215,7 +228,7 @@ class IndentationSolver:
         self.options = options or SolverOptions()
         self.options.validate()
         t0 = time.perf_counter()
-        self.hmesh = build_mesh(self.radius, density, linear=(element == "q4"))
+        self.hmesh = build_mesh(self.radius, density, linear=(element == "q4"), edge_band=edge_band)
         self.disc = Discretisation(self.hmesh, element)
         self.t_setup = time.perf_counter() - t0
         hm, nd = self.hmesh, self.disc.n_dofs
@@ -225,7 +238,10 @@ class IndentationSolver:
         self.on_axis = np.isin(self.surface, hm.axis)
         self.fixed_base = np.concatenate([2 * hm.equator + 1, 2 * hm.axis])  # u_z equator, u_r axis
         self.n_points = self.disc.n_elements * self.disc.n_qp
-        self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+        self.timers = {"constitutive": 0.0, "assembly": 0.0, "contact": 0.0, "linear": 0.0,
+                       "line_search": 0.0}
+        self.linear = SymmetricSolver(self.options.linear_solver)
+        self._diag_slots = self.disc.slots(np.arange(nd), np.arange(nd))
         self._nd = nd
         self.k_penalty = None
         if self.options.penalty is not None:
@@ -233,6 +249,12 @@ class IndentationSolver:
             pole_edge = float(np.hypot(*(x_arc[:, 2] - x_arc[:, 0])))
             self.k_penalty = self.options.penalty * material.E / pole_edge
             self.area0 = surface_areas(x_arc)[:-1]
+        self.segments = None
+        if self.options.segment_points:
+            self.segments = SegmentPenalty(self.X[:, self.arc], self.k_penalty, self.options.segment_points)
+            na = self.arc[self.segments.edges]  # (e, 3) nodes of each edge
+            self._seg_slots = self.disc.node_block_slots(
+                np.repeat(na, 3, axis=1).ravel(), np.tile(na, (1, 3)).ravel()).reshape(-1, 3, 3, 2, 2)
 
     @staticmethod
     def _nodal(v: np.ndarray, nodes: np.ndarray) -> np.ndarray:
@@ -244,79 +266,87 @@ class IndentationSolver:
         """Penalty contact at u: gap, normal, curvature, penetrating nodes, nodal force
         magnitudes p_i = k_N A_i (−g_i) and the assembled contact force vector."""
         gap, normal, curv = self.obstacle.gap_normal(self.X[:, self.surface] + self._nodal(u, self.surface))
+        fc = np.zeros(self._nd)
+        if self.segments is not None:  # pressure integrated over the edges (segment_penalty.py)
+            points = self.segments.evaluate(self.X[:, self.arc] + self._nodal(u, self.arc), self.obstacle)
+            force = points[4]
+            fc[2 * self.arc], fc[2 * self.arc + 1] = force
+            p = np.einsum("ci,ci->i", force[:, :-1], normal)  # normal reaction of each surface node
+            return gap, normal, curv, p > 0.0, p, fc, points
         pen = gap < 0.0
         p = np.where(pen, self.k_penalty * self.area0 * -gap, 0.0)
-        fc = np.zeros(self._nd)
         fc[2 * self.surface] = p * normal[0]
         fc[2 * self.surface + 1] = p * normal[1]
-        return gap, normal, curv, pen, p, fc
+        return gap, normal, curv, pen, p, fc, None
 
-    def _penalty_tangent(self, gap, normal, curv, pen) -> sp.csr_matrix:
-        """∂(−f_c)/∂u = k_N A [n nᵀ + g κ (I − n nᵀ)] at the penetrating nodes (κ: 1/|x − c|)."""
+    def _penalty_tangent(self, data, gap, normal, curv, pen, points=None):
+        """Add ∂(−f_c)/∂u = k_N A [n nᵀ + g κ (I − n nᵀ)] at the penetrating nodes (κ: 1/|x − c|),
+        or the segment-integrated blocks of :class:`SegmentPenalty`."""
+        if points is not None:
+            np.add.at(data, self._seg_slots, self.segments.tangent_blocks(*points[:4]))
+            return data
         idx = np.flatnonzero(pen)
         nodes = self.surface[idx]
         kA = self.k_penalty * self.area0[idx]
         n, gk = normal[:, idx], gap[idx] * curv[idx]
-        rows, cols, vals = [], [], []
-        for i in range(2):
-            for j in range(2):
-                rows.append(2 * nodes + i)
-                cols.append(2 * nodes + j)
-                vals.append(kA * (n[i] * n[j] + gk * ((i == j) - n[i] * n[j])))
-        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                             shape=(self._nd, self._nd))
+        nn = np.einsum("ik,jk->kij", n, n)
+        blocks = kA[:, None, None] * (nn + gk[:, None, None] * (np.eye(2) - nn))
+        np.add.at(data, self.disc.node_block_slots(nodes, nodes), blocks)
+        return data
 
     # ------------------------------------------------------------------ one Newton solve
-    def _frame(self, active: np.ndarray, normal: np.ndarray):
-        """Nodal rotation T (u = T ũ) for active off-axis nodes on a curved obstacle,
-        and the constrained local dofs carrying the contact condition."""
+    def _frames(self, active: np.ndarray, normal: np.ndarray):
+        """Nodal frames Q (u = Q ũ, Q = Qᵀ = Q⁻¹) of the active off-axis nodes on a curved
+        obstacle, and the constrained local dofs carrying the contact condition."""
         nodes = self.surface[active]
         if self.obstacle.is_flat:
             return None, 2 * nodes + 1
         rot = active & ~self.on_axis
         rn = self.surface[rot]
         n_r, n_z = normal[:, rot]
-        nd = self._nd
         # u = n ũ_n + t ũ_t with t = (n_z, −n_r): local dof 2i ↔ ũ_n, 2i+1 ↔ ũ_t
-        diag = np.ones(nd)
-        diag[2 * rn] = n_r
-        diag[2 * rn + 1] = -n_r
-        rows = np.concatenate([np.arange(nd), 2 * rn, 2 * rn + 1])
-        cols = np.concatenate([np.arange(nd), 2 * rn + 1, 2 * rn])
-        vals = np.concatenate([diag, n_z, n_z])
-        T = sp.csr_matrix((vals, (rows, cols)), shape=(nd, nd))
+        Q = np.stack([np.stack([n_r, n_z], -1), np.stack([n_z, -n_r], -1)], 1)
         on_axis_nodes = self.surface[active & self.on_axis]
-        cdofs = np.concatenate([2 * rn, 2 * on_axis_nodes + 1])
-        return T, cdofs
+        return (rn, Q), np.concatenate([2 * rn, 2 * on_axis_nodes + 1])
 
-    def _exact_contact(self, f, K, gap, normal, curv, active, log):
-        """Lagrange-multiplier contact: reactions, active-set update, nodal frame, and the
-        rotated tangent, residual and prescribed normal displacements of the constrained dofs."""
+    @staticmethod
+    def _rotate(v: np.ndarray, frames) -> np.ndarray:
+        """T v for the nodal frames (T = Tᵀ = T⁻¹: global ↔ local components)."""
+        if frames is None:
+            return v
+        nodes, Q = frames
+        out = v.copy()
+        pairs = out.reshape(-1, 2)
+        pairs[nodes] = np.einsum("nab,nb->na", Q, pairs[nodes])
+        return out
+
+    def _exact_contact(self, f, data, gap, normal, curv, active, log):
+        """Lagrange-multiplier contact: reactions, active-set update, nodal frames, and the
+        rotated tangent data, residual and prescribed normal displacements of the constrained
+        dofs (the tangent keeps the mesh's sparsity pattern)."""
         lam = np.einsum("ci,ci->i", self._nodal(f, self.surface), normal)
         changed = False
         if not log["frozen"]:
             active, changed = update_active_set(active, lam, gap, 1e-12 * self.radius, log)
-        T, cdofs = self._frame(active, normal)
-        if not self.obstacle.is_flat:
+        frames, cdofs = self._frames(active, normal)
+        if frames is not None:
             idx = np.flatnonzero(active & ~self.on_axis)
             nodes = self.surface[idx]
-            k = lam[idx] * curv[idx]
             n = normal[:, idx]
             tt = np.stack([n[1], -n[0]])
-            blk = [(0, 0, tt[0] * tt[0]), (0, 1, tt[0] * tt[1]), (1, 0, tt[1] * tt[0]),
-                   (1, 1, tt[1] * tt[1])]
-            rows = np.concatenate([2 * nodes + i for i, _, _ in blk])
-            cols = np.concatenate([2 * nodes + j for _, j, _ in blk])
-            vals = np.concatenate([-k * v for _, _, v in blk])
-            K = K + sp.csr_matrix((vals, (rows, cols)), shape=K.shape)
-            K = (T.T @ K @ T).tocsr()
-            r = T.T @ f
-        else:
-            r = f
+            blocks = -(lam[idx] * curv[idx])[:, None, None] * np.einsum("ik,jk->kij", tt, tt)
+            data = data.copy()
+            np.add.at(data, self.disc.node_block_slots(nodes, nodes), blocks)
+            Q = np.broadcast_to(np.eye(2), (self.hmesh.n_nodes, 2, 2)).copy()
+            Q[frames[0]] = frames[1]
+            rotated = np.zeros(self.hmesh.n_nodes, dtype=bool)
+            rotated[frames[0]] = True
+            data = self.disc.rotate_blocks(data, Q, rotated)
+        r = self._rotate(f, frames)
         du_c = np.zeros(self._nd)
         du_c[cdofs] = -gap[active] if self.obstacle.is_flat else np.concatenate(
             [-gap[active & ~self.on_axis], -gap[active & self.on_axis]])
-        return lam, changed, active, T, cdofs, K, r, du_c
+        return lam, changed, active, frames, cdofs, data, r, du_c
 
     def _newton(self, u: np.ndarray, h: float, state: PlasticState, active: np.ndarray):
         opt = self.options
@@ -338,21 +368,22 @@ class IndentationSolver:
                 Fv, real, f = known
                 upd, A = stress_and_tangent(Fv, state, mat, real=real)
             t1 = time.perf_counter()
-            K = disc.tangent(A)
+            data = disc.tangent(A).data
             t2 = time.perf_counter()
             if self.k_penalty is not None:
-                gap, normal, curv, pen, p, fc = self._penalty_force(u)
+                gap, normal, curv, pen, p, fc, points = self._penalty_force(u)
                 changed = not np.array_equal(pen, active)
                 active = pen
-                K = K + self._penalty_tangent(gap, normal, curv, pen)
-                r, T, cdofs = f - fc, None, np.zeros(0, dtype=int)
+                data = self._penalty_tangent(data.copy(), gap, normal, curv, pen, points)
+                self._points = points
+                r, frames, cdofs = f - fc, None, np.zeros(0, dtype=int)
                 lam = p
                 du_c = np.zeros(self._nd)
                 log["changes"] += changed
             else:
                 gap, normal, curv = self.obstacle.gap_normal(Xs + self._nodal(u, self.surface))
-                lam, changed, active, T, cdofs, K, r, du_c = self._exact_contact(
-                    f, K, gap, normal, curv, active, log)
+                lam, changed, active, frames, cdofs, data, r, du_c = self._exact_contact(
+                    f, data, gap, normal, curv, active, log)
             fixed = np.concatenate([self.fixed_base, cdofs])
             free = np.ones(self._nd, dtype=bool)
             free[fixed] = False
@@ -371,20 +402,21 @@ class IndentationSolver:
             if not changed and res <= max(opt.tol, floor) and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
                 return (u, upd, active, it, log["changes"], res_hist, f, gap, np.where(active, lam, 0.0),
                         normal)
-            Kff = K[free][:, free]
-            rhs = -r[free] - K[free][:, ~free] @ du_c[~free]
-            lu = spla.splu(Kff.tocsc(), permc_spec="MMD_AT_PLUS_A",
-                           options={"SymmetricMode": True})
-            du = du_c.copy()
-            du[free] = lu.solve(rhs)
-            if T is not None:
-                du = T @ du
-            u, known = self._line_search(u, du, free, T, state, r[free])
-            self.timers["solve"] += time.perf_counter() - t3
+            K = disc.matrix(data)
+            rhs = -r - K @ du_c
+            scale = float(np.abs(data[self._diag_slots]).mean())
+            rhs[fixed] = scale * du_c[fixed]
+            du = self.linear.solve(constrain(K, fixed, scale), rhs)
+            du[fixed] = du_c[fixed]
+            du = self._rotate(du, frames)
+            t4 = time.perf_counter()
+            self.timers["linear"] += t4 - t3
+            u, known = self._line_search(u, du, free, frames, state, r[free])
+            self.timers["line_search"] += time.perf_counter() - t4
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {res_hist[-1]:.2e})")
 
-    def _line_search(self, u, du, free, T, state, r0, max_steps: int = 4):
+    def _line_search(self, u, du, free, frames, state, r0, max_steps: int = 4):
         """u + α du by an energy line search (Crisfield 1991, §9.3).
 
         s(α) = du_f · r_f(u + α du) is the slope of the potential along the step;
@@ -395,7 +427,7 @@ class IndentationSolver:
         """
         if not self.options.line_search:
             return self._admissible(u, du), None
-        duf = (T.T @ du)[free] if T is not None else du[free]
+        duf = self._rotate(du, frames)[free]
         s0 = float(np.dot(duf, r0))
         if s0 >= 0.0:
             return self._admissible(u, du), None
@@ -406,7 +438,7 @@ class IndentationSolver:
             real = stress_update(Fv, state.cp_inv, state.eps_p, self.material)
             f = self.disc.internal_force(real.P)
             known = (Fv, real, f)
-            r = T.T @ f if T is not None else f
+            r = self._rotate(f, frames)
             if self.k_penalty is not None:
                 r = f - self._penalty_force(trial)[5]
             s_a = float(np.dot(duf, r[free]))
@@ -427,6 +459,15 @@ class IndentationSolver:
             beta *= 0.5
         raise IncrementFailed("inverted element (J <= 0) even after step halving")
 
+    def _timer_split(self) -> dict:
+        """Seconds spent per phase: constitutive update, assembly, contact, factorisation,
+        triangular solves, line search (the linear phase's remainder is the constraint setup)."""
+        t = dict(self.timers)
+        lin = self.linear.times
+        t["constraints"] = t.pop("linear") - lin["factorisation"] - lin["solve"]
+        t["factorisation"], t["solve"] = lin["factorisation"], lin["solve"]
+        return {f"{k}_s": v for k, v in t.items()}
+
     # ------------------------------------------------------------------ the incremental run
     def run(self, h_max: float, progress=None, schedule=None) -> RunResult:
         """Press the hemisphere to approach ``h_max``; ``progress(h)`` is called per increment.
@@ -443,6 +484,7 @@ class IndentationSolver:
         t_start = time.perf_counter()
         for k in self.timers:
             self.timers[k] = 0.0
+        self.linear = SymmetricSolver(opt.linear_solver)
         self.rejected = []
         nd = self._nd
         u = np.zeros(nd)
@@ -500,9 +542,14 @@ class IndentationSolver:
             F_support = -float(f[2 * self.hmesh.equator + 1].sum())
             xs = self.X[:, self.surface] + self._nodal(u, self.surface)
             F = float(np.sum(lam * normal[1]))
+            if self.segments is not None:
+                F = float(self._points[4][1].sum())
             areas = surface_areas(self.X[:, self.arc] + self._nodal(u, self.arc))[:-1]
             pressure = np.where(active, lam / areas, 0.0)
             a_nodes, a_sub, a_ref = contact_edge(self.X[0, self.surface], xs[0], gap, active)
+            if self.segments is not None:  # where the gap of the points crosses zero
+                a_ref = self.segments.contact_radius(self._points[0])
+                a_sub = float(np.interp(a_ref, self.X[0, self.surface], xs[0]))
             work += work_increment(h - dh, h, F_last, F)
             F_last = F
             hist.h.append(h)
@@ -540,14 +587,16 @@ class IndentationSolver:
         prof_r = np.array(hist.profile_r).reshape(-1, nsurf)
         prof_p = np.array(hist.profile_p).reshape(-1, nsurf)
         prof_g = np.array(hist.profile_g).reshape(-1, nsurf)
-        timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
+        timings = {"wall_s": wall, "setup_s": self.t_setup, **self._timer_split(),
                    "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum()),
-                   "rejected_increments": len(self.rejected)}
+                   "rejected_increments": len(self.rejected), **{f"linear_{k}": v for k, v in
+                                                                 self.linear.stats.items()}}
         final = {"X": self.X, "u": u, "cells": self.disc.basis.element_dofs.T.copy(),
                  "eps_p": state.eps_p.reshape(self.disc.n_elements, self.disc.n_qp)}
         inputs = {"material": self.material.describe(), "radius": R,
                   "indenter_radius": float(self.obstacle.radius), "h_max": h_max,
-                  "mesh_density": self.hmesh.density, "element": self.disc.element,
+                  "mesh_density": self.hmesh.density, "edge_band": self.hmesh.edge_band,
+                  "element": self.disc.element,
                   "n_elements": self.disc.n_elements, "n_dofs": self._nd,
                   "options": self.options.as_inputs()}
         return RunResult(inputs=inputs, curves=curves, residuals=hist.residuals,

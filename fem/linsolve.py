@@ -1,0 +1,120 @@
+"""Sparse symmetric solves for Newton: LDLᵀ with a reused symbolic analysis, SuperLU fallback.
+
+The tangent of the total-Lagrangian problem is symmetric (exact tangent of a
+potential; the contact constraints are eliminated symmetrically, see
+:func:`constrain`). ``qdldl`` (Stellato, Banjac et al., the LDLᵀ of OSQP:
+approximate minimum degree ordering, then an up-looking LDLᵀ without pivoting)
+factors it about 3× faster than SuperLU, and ``Solver.update`` refactors a
+matrix of the same sparsity pattern without redoing the ordering and the
+elimination tree. Keeping the pattern fixed for a whole run is the caller's
+job: constrained dofs keep their rows and columns as explicit zeros.
+
+LDLᵀ without pivoting can fail on an indefinite matrix (a zero pivot) or lose
+accuracy on a badly conditioned one (the saddle-point systems of Lagrange
+multipliers, a tangent near a limit point). Every solution is therefore checked
+by its residual ‖K x − b‖∞ ≤ ``rtol`` ‖b‖∞ and replaced by SuperLU's (partial
+pivoting, MMD on Kᵀ + K) when the check fails; ``stats`` counts both.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+try:  # a wheel on every platform; the solver still works (SuperLU only) without it
+    import qdldl
+except ImportError:  # pragma: no cover - exercised only where the wheel is missing
+    qdldl = None
+
+#: relative residual above which an LDLᵀ solution is rejected for SuperLU's
+RTOL = 1e-8
+
+
+def superlu_solve(K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
+    """x with K x = b by SuperLU (MMD on Kᵀ + K, symmetric mode: diagonal pivots preferred)."""
+    lu = spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+    return lu.solve(b)
+
+
+class SymmetricSolver:
+    """Repeated solves K x = b for symmetric sparse K (CSR or CSC, both triangles stored).
+
+    ``method``: ``"ldl"`` (qdldl, SuperLU fallback) or ``"superlu"`` (SuperLU only).
+    ``stats``: counts of ``ldl_fresh`` (ordering + factorisation), ``ldl_update``
+    (numeric refactorisation on the stored analysis) and ``fallback`` (SuperLU
+    used because LDLᵀ failed or was inaccurate).
+    """
+
+    def __init__(self, method: str = "ldl", rtol: float = RTOL):
+        if method not in ("ldl", "superlu"):
+            raise ValueError(f"method must be 'ldl' or 'superlu', got {method!r}")
+        if method == "ldl" and qdldl is None:
+            method = "superlu"
+        self.method = method
+        self.rtol = float(rtol)
+        self._solver = None
+        self._pattern = None
+        self.stats = {"ldl_fresh": 0, "ldl_update": 0, "fallback": 0, "superlu": 0}
+        self.times = {"factorisation": 0.0, "solve": 0.0}
+
+    def _factor(self, K: sp.csc_matrix) -> None:
+        upper = sp.triu(K, format="csc")
+        upper.sort_indices()
+        pattern = (upper.shape, upper.indptr.tobytes(), upper.indices.tobytes())
+        if self._solver is not None and pattern == self._pattern:
+            self._solver.update(upper, upper=True)
+            self.stats["ldl_update"] += 1
+        else:
+            self._solver = qdldl.Solver(upper, upper=True)
+            self._pattern = pattern
+            self.stats["ldl_fresh"] += 1
+
+    def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
+        """x with K x = b; LDLᵀ where it is accurate, SuperLU otherwise."""
+        b = np.asarray(b, dtype=float)
+        t0 = time.perf_counter()
+        if self.method == "ldl":
+            K = sp.csc_matrix(K)
+            try:
+                self._factor(K)
+                t1 = time.perf_counter()
+                self.times["factorisation"] += t1 - t0
+                x = self._solver.solve(b)
+                scale = max(float(np.abs(b).max(initial=0.0)), 1e-300)
+                ok = np.all(np.isfinite(x)) and np.abs(K @ x - b).max(initial=0.0) <= self.rtol * scale
+                self.times["solve"] += time.perf_counter() - t1
+                if ok:
+                    return x
+            except (ValueError, RuntimeError):
+                self._solver, self._pattern = None, None  # a failed factorisation is not reused
+            self.stats["fallback"] += 1
+            t0 = time.perf_counter()
+        else:
+            self.stats["superlu"] += 1
+        x = superlu_solve(K, b)
+        self.times["factorisation"] += time.perf_counter() - t0
+        return x
+
+
+def constrain(K: sp.csr_matrix, fixed: np.ndarray, diag_value: float) -> sp.csr_matrix:
+    """K with the rows and columns of ``fixed`` dofs zeroed (kept as explicit zeros) and
+    ``diag_value`` on their diagonal: a symmetric system of unchanged sparsity pattern. With
+    b[fixed] = diag_value · x_c and b[free] = b_f − K_fc x_c (the prescribed values moved to
+    the right-hand side) its solution is x_c on the fixed dofs and the reduced solution on the
+    free ones. ``K`` must store its whole diagonal."""
+    K = K.tocsr(copy=True)
+    K.sort_indices()
+    n = K.shape[0]
+    is_fixed = np.zeros(n, dtype=bool)
+    is_fixed[fixed] = True
+    rows = np.repeat(np.arange(n), np.diff(K.indptr))
+    drop = is_fixed[rows] | is_fixed[K.indices]
+    K.data[drop] = 0.0
+    diag = np.flatnonzero((rows == K.indices) & is_fixed[rows])
+    if diag.size != np.count_nonzero(is_fixed):
+        raise ValueError("constrain: the matrix must store every diagonal entry of the fixed dofs")
+    K.data[diag] = diag_value
+    return K

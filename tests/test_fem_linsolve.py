@@ -1,0 +1,83 @@
+"""Sparse symmetric solves (fem/linsolve.py) and the solver's fixed sparsity pattern."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from spherecontact.fem.contact import RigidObstacle
+from spherecontact.fem.linsolve import SymmetricSolver, constrain
+from spherecontact.fem.solver import IndentationSolver, SolverOptions
+from spherecontact.model import Material
+
+
+def _laplacian(n: int, shift: float = 0.1) -> sp.csr_matrix:
+    """SPD 2-D Laplacian plus a shift (n² unknowns)."""
+    T = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    return (sp.kronsum(T, T) + shift * sp.eye(n * n)).tocsr()
+
+
+def test_ldl_reuses_its_analysis_and_matches_superlu():
+    K = _laplacian(20)
+    b = np.random.default_rng(0).standard_normal(K.shape[0])
+    s = SymmetricSolver("ldl")
+    x1 = s.solve(K, b)
+    x2 = s.solve(K * 2.0, b)  # same pattern, new values: numeric refactorisation only
+    assert np.allclose(x1, spla.spsolve(K.tocsc(), b), rtol=1e-10, atol=1e-12)
+    assert np.allclose(x2, 0.5 * x1, rtol=1e-10, atol=1e-12)
+    assert s.stats == {"ldl_fresh": 1, "ldl_update": 1, "fallback": 0, "superlu": 0}
+
+
+def test_saddle_point_falls_back_to_superlu():
+    """A zero pivot (Lagrange-multiplier block) defeats LDLᵀ without pivoting: SuperLU answers."""
+    A = _laplacian(4)
+    B = sp.csr_matrix(np.eye(16)[:, :3])
+    K = sp.bmat([[A, B], [B.T, None]], format="csr")
+    K = K + sp.csr_matrix((np.zeros(3), (np.arange(16, 19), np.arange(16, 19))), shape=K.shape)
+    b = np.arange(19, dtype=float)
+    s = SymmetricSolver("ldl")
+    x = s.solve(K, b)
+    assert np.abs(K @ x - b).max() < 1e-10 * np.abs(b).max()
+    assert s.stats["fallback"] == 1
+
+
+def test_constrain_keeps_the_pattern_and_the_reduced_solution():
+    K = _laplacian(6)
+    n = K.shape[0]
+    fixed = np.array([0, 7, 20])
+    free = np.setdiff1d(np.arange(n), fixed)
+    b = np.linspace(1.0, 2.0, n)
+    Kc = constrain(K, fixed, 3.0)
+    assert Kc.nnz == K.nnz
+    x_c = np.array([0.25, -0.5, 1.0])
+    rhs = b - K[:, fixed] @ x_c
+    rhs[fixed] = 3.0 * x_c
+    x = spla.spsolve(Kc.tocsc(), rhs)
+    assert np.allclose(x[fixed], x_c)
+    reduced = spla.spsolve(K[free][:, free].tocsc(), b[free] - K[free][:, fixed] @ x_c)
+    assert np.allclose(x[free], reduced, rtol=1e-12)
+
+
+def test_bad_method_is_named():
+    with pytest.raises(ValueError, match="method"):
+        SymmetricSolver("cholmod")
+    with pytest.raises(ValueError, match="linear_solver"):
+        SolverOptions(linear_solver="pardiso").validate()
+
+
+@pytest.mark.parametrize("indenter", [np.inf, 1.5])
+def test_ldl_and_superlu_give_the_same_run(indenter):
+    """Flat (constrained z dofs) and rigid sphere (nodal frames rotated in place): the LDLᵀ
+    path keeps one symbolic analysis for the whole run and reproduces SuperLU's answer."""
+    runs = {}
+    for method in ("ldl", "superlu"):
+        s = IndentationSolver(Material(E=200.0, nu=0.3, sigma_y=1.0), 1.0, RigidObstacle(indenter),
+                              density=0.5, options=SolverOptions(linear_solver=method))
+        runs[method] = s.run(0.004)
+    a, b = runs["ldl"], runs["superlu"]
+    assert a.status == b.status == "converged"
+    assert np.array_equal(a.curves["iterations"], b.curves["iterations"])
+    assert np.allclose(a.F, b.F, rtol=1e-9)
+    assert a.timings["linear_ldl_fresh"] == 1
+    assert a.timings["linear_ldl_update"] == a.timings["newton_iterations"] - 1
+    assert b.timings["linear_superlu"] == b.timings["newton_iterations"]
