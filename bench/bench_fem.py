@@ -1,29 +1,58 @@
 """FE speed: the standard run (EPP, E/σY = 200, ν = 0.3, rigid flat, h/R = 0.3, default mesh).
 
-Wall time, increments, Newton iterations and the split between constitutive
-update, tangent/force assembly and linear solve (issue 3 target: under 30 s).
+Runs it twice, with the LDLᵀ factorisation that reuses its symbolic analysis
+(``linear_solver="ldl"``, the default) and with SuperLU alone (the previous
+solver), and reports for each the wall time, increments, Newton iterations,
+the split per iteration (constitutive update, assembly, contact, constraint
+setup, factorisation, triangular solves, line search) and the FE scatter of
+F and a over h/R ≥ 0.01 (max |ln y − local quadratic in ln h| over 11
+increments). Target (issue "FE reference v2"): ≤ 25 s alone, ≤ 5 iterations
+per increment.
 """
 
 from __future__ import annotations
 
-from spherecontact.fem.solver import IndentationSolver
+from spherecontact.fem.solver import IndentationSolver, SolverOptions
 from spherecontact.model import Material
+from spherecontact.validation.metrics import scatter
+
+PHASES = ("constitutive", "assembly", "contact", "constraints", "factorisation", "solve", "line_search")
+
+
+def standard_run(linear_solver: str) -> dict:
+    solver = IndentationSolver(Material(E=200.0, nu=0.3, sigma_y=1.0), 1.0,
+                               options=SolverOptions(linear_solver=linear_solver))
+    res = solver.run(0.3)
+    t = res.timings
+    its = t["newton_iterations"]
+    late = res.h >= 0.01
+    return {
+        "status": res.status,
+        "n_dofs": solver.disc.n_dofs,
+        "wall_s": round(t["wall_s"], 2),
+        "increments": t["increments"],
+        "newton_iterations": its,
+        "rejected_increments": t["rejected_increments"],
+        "iterations_per_increment": round(its / t["increments"], 2),
+        "ms_per_iteration": round(1e3 * t["wall_s"] / its, 1),
+        "ms_per_iteration_split": {k: round(1e3 * t[f"{k}_s"] / its, 2) for k in PHASES},
+        "linear": {k[len("linear_"):]: v for k, v in t.items() if k.startswith("linear_")},
+        "F_end": float(res.F[-1]),
+        "a_end": float(res.a[-1]),
+        "scatter_F": round(scatter(res.h, res.F, late), 5),
+        "scatter_a": round(scatter(res.h, res.a, late), 5),
+    }
 
 
 def main() -> dict:
-    solver = IndentationSolver(Material(E=200.0, nu=0.3, sigma_y=1.0), 1.0)
-    res = solver.run(0.3)
-    t = res.timings
+    after = standard_run("ldl")
+    before = standard_run("superlu")
     return {
         "case": "EPP E/sigma_Y=200, nu=0.3, rigid flat, h/R=0.3, default mesh",
-        "status": res.status,
-        "n_dofs": solver.disc.n_dofs,
-        "n_elements": solver.disc.n_elements,
-        **{k: (round(v, 3) if isinstance(v, float) else v) for k, v in t.items()},
-        "iterations_per_increment": round(t["newton_iterations"] / t["increments"], 2),
-        "ms_per_iteration": round(1e3 * t["wall_s"] / t["newton_iterations"], 1),
-        "rejected_increments": len(solver.rejected),
-        "F_end": float(res.F[-1]),
-        "a_end": float(res.a[-1]),
-        "target_wall_s": 30.0,
+        "ldl": after,
+        "superlu": before,
+        "speedup": round(before["wall_s"] / after["wall_s"], 2),
+        "same_answer_F_a": [abs(after[k] / before[k] - 1) for k in ("F_end", "a_end")],
+        "target_wall_s": 25.0,
+        "target_iterations_per_increment": 5.0,
     }

@@ -82,6 +82,11 @@ class Discretisation:
         sib = np.stack([((2 * I + a) * nd + 2 * J + b) for a in range(2) for b in range(2)], axis=-1)
         self._siblings = self.slots(sib // nd, sib % nd).reshape(-1, 2, 2)
 
+    @property
+    def n_entries(self) -> int:
+        """Number of stored entries of the fixed sparsity pattern."""
+        return self._nnz
+
     def slots(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Positions in the CSR data array of entries (rows, cols) of the fixed pattern."""
         keys = np.asarray(rows, dtype=np.int64) * self.n_dofs + np.asarray(cols, dtype=np.int64)

@@ -174,8 +174,12 @@ class StressUpdate:
     tau: np.ndarray  # (4, ...) Kirchhoff stress rr, rz, zz, θθ
 
 
-def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None) -> StressUpdate:
+def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None,
+                  stress_only: bool = False) -> StressUpdate | np.ndarray:
     """Exponential-map return mapping at deformation gradient ``F`` (real or complex).
+
+    ``stress_only``: return P alone (what the complex-step tangent needs), skipping the
+    updated internal variables.
 
     ``dgamma``: the real plastic multiplier from a real call; with complex F it
     is completed to first order in the imaginary perturbation (one Newton step
@@ -225,6 +229,13 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None)
     s11, s22, stt, s12 = factor * s11, factor * s22, factor * stt, factor * s12
     pk = kappa * ev
     t11, t22, ttt, t12 = pk + s11, pk + s22, pk + stt, s12
+    det = a * d - b * c
+    i11, i12, i21, i22 = d / det, -b / det, -c / det, a / det  # F⁻¹
+    # P = τ F⁻ᵀ, F⁻ᵀ = [[i11, i21], [i12, i22]]
+    P = np.stack([t11 * i11 + t12 * i12, t11 * i21 + t12 * i22,
+                  t12 * i11 + t22 * i12, t12 * i21 + t22 * i22, ttt / ftt])
+    if stress_only:
+        return P
     # elastic log strain after return; b_e = exp(2 ε_e); C_p⁻¹ = F⁻¹ b_e F⁻ᵀ
     ee11 = ev / 3 + s11 / (2 * mu)
     ee22 = ev / 3 + s22 / (2 * mu)
@@ -232,17 +243,12 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None)
     ee12 = s12 / (2 * mu)
     n11, n12, n22 = exp_sym2(2 * ee11, 2 * ee12, 2 * ee22)
     ntt = np.exp(2 * eett)
-    det = a * d - b * c
-    i11, i12, i21, i22 = d / det, -b / det, -c / det, a / det  # F⁻¹
     k11 = i11 * n11 + i12 * n12
     k12 = i11 * n12 + i12 * n22
     k21 = i21 * n11 + i22 * n12
     k22 = i21 * n12 + i22 * n22
     cp_new = np.stack([k11 * i11 + k12 * i12, k11 * i21 + k12 * i22,
                        k21 * i21 + k22 * i22, ntt / (ftt * ftt)])
-    # P = τ F⁻ᵀ, F⁻ᵀ = [[i11, i21], [i12, i22]]
-    P = np.stack([t11 * i11 + t12 * i12, t11 * i21 + t12 * i22,
-                  t12 * i11 + t22 * i12, t12 * i21 + t22 * i22, ttt / ftt])
     psi = (s11**2 + s22**2 + stt**2 + 2 * s12**2) / (4 * mu) + 0.5 * kappa * ev**2
     return StressUpdate(P=P, cp_inv=cp_new, eps_p=state_eps_p + dg, dgamma=dg, psi=psi,
                         tau=np.stack([t11, t12, t22, ttt]))
@@ -256,7 +262,7 @@ def stress_and_tangent(F, state: PlasticState, material: Material, real: StressU
     if real is None:
         real = stress_update(F, state.cp_inv, state.eps_p, material)
     Fc = F[:, None, :] + 1j * CSTEP * np.eye(5)[:, :, None]
-    cplx = stress_update(Fc, state.cp_inv[:, None, :], state.eps_p[None, :], material,
-                         dgamma=real.dgamma[None, :])
-    A = np.imag(cplx.P) / CSTEP
+    P = stress_update(Fc, state.cp_inv[:, None, :], state.eps_p[None, :], material,
+                      dgamma=real.dgamma[None, :], stress_only=True)
+    A = np.imag(P) / CSTEP
     return real, A

@@ -31,6 +31,7 @@ from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segment_penalty import SegmentPenalty
 
+CLOSE_FULL_STEP = True
 #: nodal-force roundoff of the stress update, in units of E R² (see ``_newton``)
 ROUNDOFF = 1e-16
 
@@ -411,12 +412,13 @@ class IndentationSolver:
             du = self._rotate(du, frames)
             t4 = time.perf_counter()
             self.timers["linear"] += t4 - t3
-            u, known = self._line_search(u, du, free, frames, state, r[free])
+            u, known = self._line_search(u, du, free, frames, state, r[free],
+                                         bool(np.any(du_c != 0.0)))
             self.timers["line_search"] += time.perf_counter() - t4
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {res_hist[-1]:.2e})")
 
-    def _line_search(self, u, du, free, frames, state, r0, max_steps: int = 4):
+    def _line_search(self, u, du, free, frames, state, r0, prescribed=False, max_steps: int = 4):
         """u + α du by an energy line search (Crisfield 1991, §9.3).
 
         s(α) = du_f · r_f(u + α du) is the slope of the potential along the step;
@@ -444,6 +446,8 @@ class IndentationSolver:
             s_a = float(np.dot(duf, r[free]))
             if abs(s_a) <= 0.5 * abs(s0):
                 return trial, known
+            if alpha == 1.0 and CLOSE_FULL_STEP and prescribed:
+                return trial, known  # the step puts penetrating nodes back on the obstacle
             if s_a < 0.0:  # still descending: the zero lies beyond α
                 return trial, known
             new = lo + (alpha - lo) * s_lo / (s_lo - s_a)

@@ -79,5 +79,6 @@ def test_ldl_and_superlu_give_the_same_run(indenter):
     assert np.array_equal(a.curves["iterations"], b.curves["iterations"])
     assert np.allclose(a.F, b.F, rtol=1e-9)
     assert a.timings["linear_ldl_fresh"] == 1
-    assert a.timings["linear_ldl_update"] == a.timings["newton_iterations"] - 1
-    assert b.timings["linear_superlu"] == b.timings["newton_iterations"]
+    # every later factorisation (rejected increments' included) reuses the first analysis
+    assert a.timings["linear_ldl_update"] >= a.timings["newton_iterations"] - 1
+    assert a.timings["linear_fallback"] == 0 and b.timings["linear_superlu"] >= b.timings["newton_iterations"]
