@@ -126,7 +126,8 @@ def _check_output(out) -> Path:
 
 
 class _Progress:
-    """tqdm bar over h/h_max on stderr (off with --quiet or when stderr is no TTY)."""
+    """tqdm bar over the largest h/h_max reached, on stderr (off with --quiet or when stderr is
+    no TTY)."""
 
     def __init__(self, h_max: float, quiet: bool):
         from tqdm import tqdm
@@ -137,7 +138,7 @@ class _Progress:
                                    "[{elapsed}<{remaining}]")
 
     def __call__(self, h: float) -> None:
-        self.bar.update(h - self.bar.n)
+        self.bar.update(max(h - self.bar.n, 0.0))
 
     def close(self) -> None:
         self.bar.close()
@@ -149,6 +150,10 @@ def _summary(result, path: Path) -> str:
     n = len(result.curves["h"])
     last = (f"h = {result.h[-1]:.6g}, F = {result.F[-1]:.6g}, a = {result.a[-1]:.6g}" if n
             else "no converged increment")
+    cyc = getattr(result, "cycles", None) or {}
+    if cyc:
+        last += "; h_res/h_max = " + ", ".join(f"{r / m:.4g}" for r, m in zip(cyc["h_res"], cyc["h_max"],
+                                                                              strict=True))
     return (f"fem run {result.status}: {n} increments, {t.get('newton_iterations', 0)} Newton "
             f"iterations, wall {t.get('wall_s', float('nan')):.2f} s; {last} -> {path}")
 
@@ -164,7 +169,8 @@ def run_command(args: argparse.Namespace) -> int:
         radius2 = args.radius
     checked = check_inputs(material, args.radius, args.h_max, args.indenter_radius,
                            args.mesh_density, args.element, options, radius2=radius2,
-                           material2=material2, scene=args.scene.replace("-", "_"))
+                           material2=material2, scene=args.scene.replace("-", "_"),
+                           unload_at=args.unload_at)
     print(f"scene: {checked['scene']} ({SCENES[checked['scene']]})", file=sys.stderr)
     bar = _Progress(args.h_max, args.quiet)
     try:
@@ -172,7 +178,7 @@ def run_command(args: argparse.Namespace) -> int:
                                  indenter_radius=args.indenter_radius, density=args.mesh_density,
                                  element=args.element, options=options, progress=bar,
                                  radius2=radius2, material2=material2,
-                                 scene=args.scene.replace("-", "_"))
+                                 scene=args.scene.replace("-", "_"), unload_at=args.unload_at)
     finally:
         bar.close()
     extra = {"entry_point": "spherecontact fem run",
@@ -202,6 +208,15 @@ def _add_material(add) -> None:
              "sigma > 0 non-decreasing; extrapolated with the last slope")
 
 
+def _approach_list(text: str) -> list[float]:
+    """``--unload-at``: comma-separated approaches."""
+    try:
+        return [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--unload-at takes comma-separated numbers, e.g. 0.01,0.03, got {text!r}") from None
+
+
 def _add_geometry(add) -> None:
     """Geometry and loading options."""
     grp = "geometry and loading (lengths in the unit of --radius)"
@@ -209,6 +224,9 @@ def _add_geometry(add) -> None:
     add(grp, "--h-max", type=float, required=True,
         help="final approach h = h1 + h2 (shortening between the two bodies' equatorial "
              "planes), in (0, 0.8 min(R, R2)] (equal pairs: (0, 1.6 R])")
+    add(grp, "--unload-at", type=_approach_list, default=None, metavar="H1,H2,...",
+        help="unload fully (until the force vanishes) at each of these increasing approaches in "
+             "(0, h-max], then reload; e.g. 0.01,0.03,0.1,0.3 (default: monotone loading)")
     add(grp, "--indenter-radius", type=float, default=math.inf, metavar="R2",
         help="radius of a rigid spherical indenter, > 0 (default inf: rigid flat, i.e. two "
              "equal spheres by symmetry)")

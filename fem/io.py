@@ -18,6 +18,11 @@ version 1), so a database can later copy it as one group among many
       mesh/u                  (2 n_nodes,) final displacement, interleaved (u_r, u_z)
       mesh/cells              (n_el, 8|4) node indices
       mesh/eps_p              (n_el, n_qp) final equivalent plastic strain at the Gauss points
+      cycles/<name>           (n_cyc,) or (n_cyc, n_surf) per unloading branch (``CYCLES``);
+                              present only in runs with unloading cycles
+
+Increments are stored in the order computed; ``curves/branch`` labels each one
+(0 load, 1 unload, 2 reload: elastic reloading below the largest approach reached).
 
 Units are consistent: lengths in the unit of the radius, stresses in the unit
 of E, forces = stress × length², energies = force × length.
@@ -33,7 +38,7 @@ import secrets
 import socket
 import subprocess
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import h5py
@@ -43,7 +48,7 @@ from ..model.material import Material
 from .assembly import ELEMENTS
 from .contact import RigidObstacle
 from .mesh import DENSITY_RANGE
-from .solver import IndentationSolver, RunResult, SolverOptions
+from .solver import IndentationSolver, RunResult, SolverOptions, check_unload_at
 from .twobody import TwoBodySolver
 
 __all__ = [
@@ -89,6 +94,24 @@ CURVES = {
     "dissipation_2": ("energy", "plastic dissipation in body 2"),
     "eps_p_max_1": ("1", "largest equivalent plastic strain in body 1"),
     "eps_p_max_2": ("1", "largest equivalent plastic strain in body 2"),
+    "branch": ("label", "0 load, 1 unload, 2 reload (below the largest approach reached)"),
+}
+#: per unloading branch (``cycles/<name>``): name → (unit, description)
+CYCLES = {
+    "h_max": ("length", "approach at which the unloading starts"),
+    "F_max": ("force", "force there"),
+    "a_max": ("length", "contact radius there (deformed)"),
+    "h_res": ("length", "residual approach: where the unloading force returns to 0"),
+    "pole_radius": ("length", "curvature radius of the unloaded surface at the pole"),
+    "work_in": ("energy", "external work from the end of the previous cycle to h_max"),
+    "work_returned": ("energy", "work returned by the unloading, from h_max to h_res"),
+    "dissipation": ("energy", "plastic dissipation of the cycle (previous cycle's end to h_res)"),
+    "elastic_energy_change": ("energy", "change of stored elastic energy over the same cycle"),
+    "increment_start": ("index", "first increment of the cycle's loading"),
+    "increment_peak": ("index", "increment at h_max"),
+    "increment_end": ("index", "last increment of the unloading (at h_res)"),
+    "profile_r": ("length", "(n_cyc, n_surf) deformed r of the surface nodes at h_res"),
+    "profile_z": ("length", "(n_cyc, n_surf) deformed z of the surface nodes at h_res"),
 }
 #: scenes: how a pair of bodies is modelled (the cheapest exact one is chosen)
 SCENES = {
@@ -171,7 +194,7 @@ def choose_scene(material, radius, material2=None, radius2=None,
 
 def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
                  element="q8r", options=None, progress=None, radius2=None, material2=None,
-                 scene="auto") -> dict:
+                 scene="auto", unload_at=None) -> dict:
     """Validate every input of :func:`run_indentation`; return them normalised.
 
     Raises ValueError naming the parameter and its allowed range.
@@ -216,9 +239,14 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
     options.validate()
     if progress is not None and not callable(progress):
         raise ValueError("progress must be a callable progress(h) or None")
+    unload = check_unload_at(unload_at, h)
+    if unload.size and chosen == "two_body":
+        raise ValueError("unload_at: unloading cycles are available for one sphere on a rigid flat "
+                         "or rigid sphere and for the equal pair; not yet for two deformable bodies")
     return {"material": material, "radius": R, "h_max": h, "indenter_radius": R_ind,
             "density": d, "element": element, "options": options, "progress": progress,
-            "material2": material2, "radius2": R2, "scene": chosen}
+            "material2": material2, "radius2": R2, "scene": chosen,
+            "unload_at": unload if unload.size else None}
 
 
 def _with_pair_curves(result: RunResult, scene: str) -> RunResult:
@@ -240,6 +268,12 @@ def _with_pair_curves(result: RunResult, scene: str) -> RunResult:
              eps_p_max_2=c["eps_p_max"].copy(), interface_curvature=np.where(c["a"] > 0, 0.0, np.nan))
     for k in ("work_external", "energy_elastic", "dissipation"):
         c[k] = 2.0 * c[k]
+    cyc = result.cycles
+    for k in ("h_max", "h_res", "work_in", "work_returned", "dissipation", "elastic_energy_change"):
+        if k in cyc:
+            cyc[k] = 2.0 * cyc[k]
+    if result.inputs.get("unload_at"):
+        result.inputs["unload_at"] = [2.0 * x for x in result.inputs["unload_at"]]
     result.inputs.update(h_max=2.0 * result.inputs["h_max"], radius2=result.inputs["radius"],
                          material2=result.inputs["material"])
     return result
@@ -250,7 +284,7 @@ def run_indentation(material: Material, radius: float, h_max: float,
                     element: str = "q8r", options: SolverOptions | None = None,
                     progress: Callable[[float], object] | None = None,
                     radius2: float | None = None, material2: Material | None = None,
-                    scene: str = "auto", schedule=None) -> RunResult:
+                    scene: str = "auto", schedule=None, unload_at=None) -> RunResult:
     """Press a hemisphere of ``radius`` and ``material`` on its partner up to ``h_max``.
 
     Partner: ``indenter_radius`` (rigid flat for inf, else a rigid sphere), or body 2
@@ -262,11 +296,14 @@ def run_indentation(material: Material, radius: float, h_max: float,
     (8-node, reduced integration) or ``"q4"`` (bilinear, locks). Every input is
     checked before any mesh is built; ``progress(h)`` is called after each
     converged increment. ``schedule`` (one-body scenes): the approaches to step to
-    instead of adaptive increments (``IndentationSolver.run``). Returns the solver's
-    ``RunResult``.
+    instead of adaptive increments (``IndentationSolver.run``). ``unload_at``: increasing
+    approaches in (0, h_max] at which the pair is unloaded until the force vanishes and then
+    reloaded (one-body scenes; labels in ``curves["branch"]``, summaries in ``cycles``).
+    Returns the solver's ``RunResult``.
     """
     a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
-                     progress, radius2, material2, scene)
+                     progress, radius2, material2, scene, unload_at)
+    unload_at = a["unload_at"]
     chosen = a["scene"]
     if chosen == "two_body":
         if schedule is not None:
@@ -287,7 +324,10 @@ def run_indentation(material: Material, radius: float, h_max: float,
                                density=a["density"], element=a["element"], options=a["options"])
     if schedule is not None and chosen == "equal_pair_symmetry":
         schedule = 0.5 * np.asarray(schedule, dtype=float)
-    result = _with_pair_curves(solver.run(h_run, progress=progress, schedule=schedule), chosen)
+    if unload_at is not None and chosen == "equal_pair_symmetry":
+        unload_at = 0.5 * unload_at
+    result = _with_pair_curves(solver.run(h_run, progress=progress, schedule=schedule,
+                                          unload_at=unload_at), chosen)
     if a["material2"] is not None and a["material2"].is_rigid:
         result.inputs.update(material2=a["material2"].describe(), radius2=a["radius2"])
     return result
@@ -469,6 +509,11 @@ def write_run_group(parent: h5py.Group, name: str, result: RunResult,
         _dataset(profiles, pname, np.asarray(getattr(result, attr), dtype=float),
                  units=PROFILE_UNITS[pname])
     _write_mesh(g, result.final)
+    if getattr(result, "cycles", None):
+        cyc = g.create_group("cycles")
+        for cname, values in result.cycles.items():
+            unit, description = CYCLES.get(cname, ("unknown", ""))
+            _dataset(cyc, cname, np.asarray(values), units=unit, description=description)
     return g
 
 
@@ -554,6 +599,7 @@ class Run:
     profile_gap: np.ndarray
     mesh: dict
     source: str = ""
+    cycles: dict = field(default_factory=dict)
 
     def __getattr__(self, name: str):
         """Curves as attributes (only called when normal lookup fails)."""
@@ -696,12 +742,13 @@ def run_from_group(g: h5py.Group, source: str = "") -> Run:
     profiles = {name: _read_array(g["profiles"], name) for name in PROFILES}
     mesh = {name: _read_array(g["mesh"], name) for name in MESH}
     _check_shapes(curves, offsets, values, profiles, mesh)
+    cycles = {name: _read_array(g["cycles"], name) for name in g["cycles"]} if "cycles" in g else {}
     residuals = [values[offsets[k]:offsets[k + 1]] for k in range(offsets.size - 1)]
     return Run(inputs=_unflatten(g.attrs, INPUT_PREFIX), curves=curves,
                status=_python_value(g.attrs["status"]), reason=_python_value(g.attrs["reason"]),
                provenance=_unflatten(g.attrs, PROVENANCE_PREFIX), residuals=residuals,
                profile_r=profiles["r"], profile_p=profiles["p"], profile_gap=profiles["gap"],
-               mesh=mesh, source=source)
+               mesh=mesh, source=source, cycles=cycles)
 
 
 def read_run(path, group: str = GROUP) -> Run:

@@ -63,6 +63,9 @@ class SolverOptions:
     #: 0: penalty at the nodes; n > 0: penalty pressure integrated at n Gauss points per surface
     #: edge (segment_penalty.py), which needs ``penalty``
     segment_points: int = 0
+    #: increments per unloading branch, spread over the elastic recovery 1.5 F_max/(2E*a)
+    #: (elastic reloading below the previous maximum uses the same increment)
+    unload_increments: int = 24
 
     def as_inputs(self) -> dict:
         """The options as stored with a run; None values are left out (HDF5 attributes have no
@@ -87,6 +90,9 @@ class SolverOptions:
                              f"got {self.segment_points!r}")
         if self.segment_points and self.penalty is None:
             raise ValueError("segment_points > 0 needs penalty contact: set penalty (> 0) as well")
+        if not (isinstance(self.unload_increments, int) and 4 <= self.unload_increments <= 1000):
+            raise ValueError(f"unload_increments must be an integer in [4, 1000], got "
+                             f"{self.unload_increments!r}")
         if self.linear_solver not in ("ldl", "superlu"):
             raise ValueError(f"linear_solver must be 'ldl' or 'superlu', got {self.linear_solver!r}")
         if self.penalty is not None and not (isinstance(self.penalty, (int, float))
@@ -116,6 +122,7 @@ class History:
     profile_p: list = field(default_factory=list)
     profile_g: list = field(default_factory=list)
     penetration: list = field(default_factory=list)
+    branch: list = field(default_factory=list)
 
 
 @dataclass
@@ -132,6 +139,7 @@ class RunResult:
     reason: str
     timings: dict
     final: dict  # final deformed mesh and fields
+    cycles: dict = field(default_factory=dict)  # per unloading branch (cycles_as_arrays)
 
     @property
     def h(self):
@@ -157,6 +165,13 @@ def work_increment(h0: float, h1: float, F0: float, F1: float) -> float:
     if abs(p + 1.0) < 1e-9:
         return F0 * h0 * np.log(h1 / h0)
     return (F1 * h1 - F0 * h0) / (p + 1.0)
+
+
+def quadratic_work(h0: float, h1: float, h2: float, F0: float, F1: float, F2: float) -> float:
+    """∫ F dh over [h1, h2] of the parabola through (h0, F0), (h1, F1), (h2, F2) (error O(Δh⁴))."""
+    c = np.polyfit([h0 - h1, 0.0, h2 - h1], [F0, F1, F2], 2)
+    d = h2 - h1
+    return float(c[0] * d**3 / 3 + c[1] * d**2 / 2 + c[2] * d)
 
 
 def update_active_set(active: np.ndarray, lam: np.ndarray, gap: np.ndarray, gap_tol: float,
@@ -206,13 +221,97 @@ def plastic_dissipation(disc: Discretisation, material: Material, eps_p_n: np.nd
 def finish_curves(curves: dict) -> dict:
     """Smoothed contact radii (raw ones kept), mean pressure and integer counters."""
     curves["a_raw"], curves["a_ref_raw"] = curves["a"], curves["a_ref"]
-    curves["a"] = smooth_contact_radius(curves["h"], curves["a_raw"])
-    curves["a_ref"] = smooth_contact_radius(curves["h"], curves["a_ref_raw"])
+    branch = curves.get("branch", np.zeros(curves["h"].size))
+    curves["a"], curves["a_ref"] = curves["a_raw"].copy(), curves["a_ref_raw"].copy()
+    # smoothed over each run of increments of one branch (h monotone there)
+    cuts = np.flatnonzero(np.diff(branch) != 0) + 1
+    for seg in np.split(np.arange(branch.size), cuts):
+        if seg.size:
+            curves["a"][seg] = smooth_contact_radius(curves["h"][seg], curves["a_raw"][seg])
+            curves["a_ref"][seg] = smooth_contact_radius(curves["h"][seg], curves["a_ref_raw"][seg])
     with np.errstate(divide="ignore", invalid="ignore"):
         curves["p_m"] = np.where(curves["a"] > 0, curves["F"] / (np.pi * curves["a"] ** 2), 0.0)
-    for k in ("iterations", "active_changes"):
-        curves[k] = curves[k].astype(int)
+    for k in ("iterations", "active_changes", "branch"):
+        if k in curves:
+            curves[k] = curves[k].astype(int)
     return curves
+
+#: branch labels of ``curves["branch"]``
+LOAD, UNLOAD, RELOAD = 0, 1, 2
+#: per-cycle summaries of ``RunResult.cycles`` (one value per unloading branch)
+CYCLE_KEYS = ("h_max", "F_max", "a_max", "h_res", "pole_radius", "work_in", "work_returned",
+              "dissipation", "elastic_energy_change", "increment_start", "increment_peak",
+              "increment_end")
+
+
+def check_unload_at(unload_at, h_max: float) -> np.ndarray:
+    """The unloading approaches as an increasing array in (0, h_max]; ValueError otherwise."""
+    if unload_at is None:
+        return np.zeros(0)
+    pts = np.atleast_1d(np.asarray(unload_at, dtype=float))
+    if pts.ndim != 1 or pts.size == 0 or not np.all(np.isfinite(pts)):
+        raise ValueError(f"unload_at must be a non-empty list of finite approaches, got {unload_at!r}")
+    if np.any(pts <= 0) or np.any(pts > h_max * (1 + 1e-12)):
+        raise ValueError(f"unload_at: every unloading approach must lie in (0, h_max] = (0, {h_max:g}], "
+                         f"got {pts.tolist()}")
+    if np.any(np.diff(pts) <= 0):
+        raise ValueError(f"unload_at must be strictly increasing, got {pts.tolist()}")
+    return np.minimum(pts, h_max)
+
+
+def residual_approach(h: np.ndarray, F: np.ndarray) -> float:
+    """Approach where an unloading curve reaches F = 0, from its last two points with F > 0 and
+    the Hertzian end of unloading F ∝ (h − h_res)^{3/2} (Thornton 1997); linear if that fails."""
+    (h1, h2), (F1, F2) = h[-2:], F[-2:]
+    r = (F2 / F1) ** (2.0 / 3.0)
+    h_res = (h2 - r * h1) / (1.0 - r) if r < 1.0 else h2
+    if not (0.0 <= h_res <= h2):
+        h_res = h2 - F2 * (h1 - h2) / (F1 - F2) if F1 > F2 else h2
+    return float(max(h_res, 0.0))
+
+
+def pole_radius(r: np.ndarray, z: np.ndarray, r_fit: float) -> float:
+    """Curvature radius of a surface z(r) at the pole: least squares z = z₀ + r²/(2 R_p) over
+    r ≤ r_fit (inf for a flat pole, negative for a dent that curves the other way)."""
+    sel = r <= r_fit
+    if sel.sum() < 3:
+        return float("nan")
+    A = np.stack([np.ones(sel.sum()), r[sel] ** 2 / 2], axis=1)
+    (_, k), *_ = np.linalg.lstsq(A, z[sel], rcond=None)
+    return float(1.0 / k) if k != 0 else float("inf")
+
+
+def cycles_as_arrays(cycles: list[dict], n_surface: int) -> dict:
+    """Per-cycle summaries as arrays (``CYCLE_KEYS``) plus the residual surface
+    (``profile_r``, ``profile_z``: (n_cycles, n_surface) deformed r, z of the unloaded surface)."""
+    out = {k: np.array([c[k] for c in cycles], dtype=float) for k in CYCLE_KEYS}
+    for k in ("profile_r", "profile_z"):
+        out[k] = np.array([c[k] for c in cycles], dtype=float).reshape(-1, n_surface)
+    return out if cycles else {}
+
+
+@dataclass
+class _RunState:
+    """The state an incremental run carries from one converged increment to the next."""
+
+    t_start: float
+    u: np.ndarray
+    state: PlasticState
+    active: np.ndarray
+    dh: float
+    u_prev: np.ndarray | None = None
+    dh_prev: float | None = None
+    h: float = 0.0
+    h_top: float = 0.0  # largest approach reached so far
+    work: float = 0.0
+    F: float = 0.0
+    a: float = 0.0
+    status: str = "converged"
+    reason: str = "reached h_max"
+    dh_cycle: float = 0.0  # increment of the current unloading branch and elastic reloading
+    last_iterations: int = 0
+    cycle_base: dict = field(default_factory=lambda: {"work": 0.0, "dissipation": 0.0,
+                                                      "energy_elastic": 0.0, "increment": 0})
 
 
 class IndentationSolver:
@@ -463,6 +562,189 @@ class IndentationSolver:
             beta *= 0.5
         raise IncrementFailed("inverted element (J <= 0) even after step halving")
 
+    # ------------------------------------------------------------------ increments and legs
+    def _solve(self, run: _RunState, h_new: float):
+        """Newton for one increment to approach ``h_new`` from the run's state; returns the
+        converged tuple of :meth:`_newton`, or the exception when it failed (recorded)."""
+        dh = h_new - run.h
+        if run.u_prev is None:  # first increment, or the first after a reversal
+            u_pred = run.u.copy()
+            if run.h == 0.0:  # rigid translation by dh/2: its intersection radius √(R dh) is Hertz's a
+                u_pred[1::2] -= 0.5 * dh
+        else:  # secant predictor
+            u_pred = run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
+        u_pred[2 * self.hmesh.equator + 1] = -h_new
+        u_pred[2 * self.hmesh.axis] = 0.0
+        try:
+            return self._newton(u_pred, h_new, run.state, run.active.copy())
+        except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
+            self.rejected.append((h_new, dh, str(err)))
+            return err
+
+    def _contact_force(self, lam, normal) -> float:
+        """Axial contact force of a converged state."""
+        if self.segments is not None:
+            return float(self._points[4][1].sum())
+        return float(np.sum(lam * normal[1]))
+
+    def _commit(self, run: _RunState, h_new: float, solved, branch: int) -> None:
+        """Record a converged increment and make it the run's state."""
+        hist = self._hist
+        u_new, upd, act, its, changes, res_hist, f, gap, lam, normal = solved
+        state = run.state
+        diss_inc = plastic_dissipation(self.disc, self.material, state.eps_p, upd.dgamma)
+        run.state = PlasticState(upd.cp_inv, upd.eps_p, state.dissipation + diss_inc)
+        dh = h_new - run.h
+        run.u_prev, run.u, run.dh_prev, run.active = run.u, u_new, dh, act
+        F_support = -float(f[2 * self.hmesh.equator + 1].sum())
+        xs = self.X[:, self.surface] + self._nodal(u_new, self.surface)
+        F = self._contact_force(lam, normal)
+        areas = surface_areas(self.X[:, self.arc] + self._nodal(u_new, self.arc))[:-1]
+        pressure = np.where(act, lam / areas, 0.0)
+        a_nodes, a_sub, a_ref = contact_edge(self.X[0, self.surface], xs[0], gap, act)
+        if self.segments is not None:  # where the gap of the points crosses zero
+            a_ref = self.segments.contact_radius(self._points[0])
+            a_sub = float(np.interp(a_ref, self.X[0, self.surface], xs[0]))
+        if branch == LOAD:
+            run.work += work_increment(run.h, h_new, run.F, F)
+        elif hist.branch and hist.branch[-1] == branch and len(hist.h) >= 2:
+            # unloading and elastic reloading: the parabola through this and the last two points
+            run.work += quadratic_work(hist.h[-2], run.h, h_new, hist.F[-2], run.F, F)
+        else:  # first interval of a branch
+            run.work += 0.5 * (run.F + F) * dh
+        run.h, run.F, run.a = h_new, F, a_ref
+        run.h_top = max(run.h_top, h_new)
+        hist.h.append(h_new)
+        hist.F.append(F)
+        hist.F_support.append(F_support)
+        hist.a.append(a_sub)
+        hist.a_nodes.append(a_nodes)
+        hist.a_ref.append(a_ref)
+        hist.eps_p_max.append(float(run.state.eps_p.max()))
+        hist.penetration.append(float(max(-gap.min(initial=0.0), 0.0)))
+        hist.work_external.append(run.work)
+        hist.energy_elastic.append(self.disc.integrate(upd.psi))
+        hist.dissipation.append(run.state.dissipation)
+        hist.iterations.append(its)
+        hist.active_changes.append(changes)
+        hist.residuals.append(res_hist)
+        hist.profile_r.append(xs[0].copy())
+        hist.profile_p.append(pressure)
+        # penalty contact: the closed nodes' gap is their penetration
+        hist.profile_g.append(gap if self.k_penalty is not None else np.where(act, 0.0, gap))
+        hist.branch.append(branch)
+        if self._progress is not None:
+            self._progress(h_new)
+        run.last_iterations = its
+
+    def _out_of_time(self, run: _RunState) -> bool:
+        if time.perf_counter() - run.t_start > self.options.max_wall_s:
+            run.status = "stopped"
+            run.reason = (f"wall-time limit of {self.options.max_wall_s:g} s reached at "
+                          f"h/R = {run.h / self.radius:.6g}")
+            return True
+        return False
+
+    def _cut_back(self, run: _RunState, dh: float, err) -> bool:
+        """False (and the run stopped) when the halved increment falls below dh_min."""
+        if 0.5 * dh < self.options.dh_min * self.radius:
+            run.status = "stopped"
+            run.reason = (f"increment below dh_min = {self.options.dh_min:g} R at "
+                          f"h/R = {run.h / self.radius:.6g}: {err}")
+            return False
+        return True
+
+    def _load_leg(self, run: _RunState, peak: float, targets=None) -> bool:
+        """Load (elastic reloading first, below the largest approach reached) up to ``peak``."""
+        opt, R = self.options, self.radius
+        while run.h < peak * (1 - 1e-12):
+            if self._out_of_time(run):
+                return False
+            if run.h < run.h_top * (1 - 1e-12):  # elastic reloading up to the previous maximum
+                dh, branch = min(run.dh_cycle, run.h_top - run.h), RELOAD
+            else:
+                a_last = self._hist.a_nodes[-1] if self._hist.a_nodes else 0.0
+                if targets is not None:
+                    ahead = targets[targets > run.h * (1 + 1e-12)]
+                    run.dh = min(run.dh, (ahead[0] if ahead.size else peak) - run.h)
+                else:
+                    run.dh = min(run.dh, peak - run.h, opt.dh_max * R,
+                                 max(opt.strain_increment * a_last, opt.dh_first * R))
+                dh, branch = run.dh, LOAD
+            solved = self._solve(run, run.h + dh)
+            if isinstance(solved, Exception):
+                if not self._cut_back(run, dh, solved):
+                    return False
+                if branch == RELOAD:
+                    run.dh_cycle *= 0.5
+                else:
+                    run.dh *= 0.5
+                continue
+            self._commit(run, run.h + dh, solved, branch)
+            if branch == LOAD:
+                if targets is not None:
+                    run.dh = np.inf
+                elif run.last_iterations <= opt.easy_iterations:
+                    run.dh *= opt.growth
+        return True
+
+    def _unload_leg(self, run: _RunState) -> dict | None:
+        """Unload from the current approach until the force vanishes; the cycle's summary.
+
+        Increments: about ``options.unload_increments`` over the elastic recovery estimated from
+        Sneddon's initial stiffness 2E*a, Δh ≈ 1.5 F_max/(2E*a). The last increment lands on
+        h_res, extrapolated from the last two points with F > 0 (:func:`residual_approach`).
+        """
+        hist, R = self._hist, self.radius
+        i_peak = len(hist.h) - 1
+        h_peak, F_peak, a_peak = run.h, run.F, run.a
+        E_star = self.material.E / (1.0 - self.material.nu**2)  # rigid partner
+        recovery = 1.5 * F_peak / (2.0 * E_star * a_peak) if a_peak > 0 else run.h
+        run.dh_cycle = max(min(recovery, run.h) / self.options.unload_increments, self.options.dh_min * R * 4)
+        run.u_prev = None
+        dh = run.dh_cycle
+        lost, h_lost = False, 0.0
+        while True:
+            if self._out_of_time(run):
+                return None
+            if not lost:
+                h_new = run.h - dh
+            elif len(hist.h) - i_peak >= 2:
+                h_new = min(max(residual_approach(np.array(hist.h[i_peak:]), np.array(hist.F[i_peak:])),
+                                h_lost), run.h)
+            else:
+                h_new = 0.5 * (run.h + h_lost)
+            if h_new <= 0.0:
+                h_new, lost = 0.0, True
+            solved = self._solve(run, h_new)
+            if isinstance(solved, Exception):
+                if not self._cut_back(run, dh, solved):
+                    return None
+                dh *= 0.5
+                continue
+            F_new = self._contact_force(solved[8], solved[9])
+            if lost or (F_new > 1e-9 * F_peak and np.any(solved[2])):
+                self._commit(run, h_new, solved, UNLOAD)
+                if lost or h_new == 0.0:
+                    break
+                continue
+            lost, h_lost = True, h_new  # contact lost between run.h and h_new: land on h_res next
+        base = run.cycle_base
+        i_end = len(hist.h) - 1
+        xs = self.X[:, self.surface] + self._nodal(run.u, self.surface)
+        cycle = {"h_max": h_peak, "F_max": F_peak, "a_max": hist.a[i_peak], "h_res": run.h,
+                 "pole_radius": pole_radius(xs[0], xs[1], 0.5 * hist.a[i_peak]),
+                 "work_in": hist.work_external[i_peak] - base["work"],
+                 "work_returned": hist.work_external[i_peak] - hist.work_external[i_end],
+                 "dissipation": hist.dissipation[i_end] - base["dissipation"],
+                 "elastic_energy_change": hist.energy_elastic[i_end] - base["energy_elastic"],
+                 "increment_start": base["increment"], "increment_peak": i_peak, "increment_end": i_end,
+                 "profile_r": xs[0].copy(), "profile_z": xs[1].copy()}
+        run.cycle_base = {"work": hist.work_external[i_end], "dissipation": hist.dissipation[i_end],
+                          "energy_elastic": hist.energy_elastic[i_end], "increment": i_end + 1}
+        run.u_prev = None
+        return cycle
+
     def _timer_split(self) -> dict:
         """Seconds spent per phase: constitutive update, assembly, contact, factorisation,
         triangular solves, line search (the linear phase's remainder is the constraint setup)."""
@@ -473,117 +755,59 @@ class IndentationSolver:
         return {f"{k}_s": v for k, v in t.items()}
 
     # ------------------------------------------------------------------ the incremental run
-    def run(self, h_max: float, progress=None, schedule=None) -> RunResult:
+    def run(self, h_max: float, progress=None, schedule=None, unload_at=None) -> RunResult:
         """Press the hemisphere to approach ``h_max``; ``progress(h)`` is called per increment.
 
         ``schedule``: increasing approaches the run steps to instead of its adaptive
         increments (cut back only where one fails), e.g. another run's approaches, so two runs
         compare without the path dependence of plasticity on the increment sequence.
+        ``unload_at``: increasing approaches in (0, h_max] at which the body is unloaded until
+        the force vanishes and then reloaded (:func:`check_unload_at`); every increment is
+        labelled in ``curves["branch"]`` (0 load, 1 unload, 2 reload) and each unloading
+        branch is summarised in ``result.cycles``.
         """
         R = self.radius
         h_max = float(h_max)
         if not (np.isfinite(h_max) and 0 < h_max <= 0.8 * R):
             raise ValueError(f"h_max must lie in (0, 0.8 R] = (0, {0.8 * R:g}], got {h_max!r}")
+        unload = check_unload_at(unload_at, h_max)
+        if unload.size and schedule is not None:
+            raise ValueError("schedule and unload_at cannot be combined (schedule: monotone loading)")
         opt = self.options
-        t_start = time.perf_counter()
+        run = _RunState(t_start=time.perf_counter(), u=np.zeros(self._nd),
+                        state=PlasticState.virgin(self.n_points),
+                        active=np.zeros(self.surface.size, dtype=bool), dh=opt.dh_first * R)
         for k in self.timers:
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(opt.linear_solver)
         self.rejected = []
-        nd = self._nd
-        u = np.zeros(nd)
-        u_prev = None
-        state = PlasticState.virgin(self.n_points)
-        active = np.zeros(self.surface.size, dtype=bool)
         hist = History()
-        h, dh, dh_prev = 0.0, opt.dh_first * R, None
+        self._hist, self._progress = hist, progress
         targets = None
         if schedule is not None:
             targets = np.asarray(schedule, dtype=float)
             if targets.ndim != 1 or np.any(np.diff(targets) <= 0) or not np.all(targets > 0):
                 raise ValueError("schedule must be an increasing sequence of approaches > 0")
             targets = np.append(targets[targets < h_max * (1 - 1e-12)], h_max)
-            dh = np.inf
-        status, reason = "converged", "reached h_max"
-        work = 0.0
-        F_last = 0.0
-        while h < h_max * (1 - 1e-12):
-            if time.perf_counter() - t_start > opt.max_wall_s:
-                status = "stopped"
-                reason = f"wall-time limit of {opt.max_wall_s:g} s reached at h/R = {h / R:.6g}"
+            run.dh = np.inf
+        peaks = list(unload)
+        if not peaks or peaks[-1] < h_max * (1 - 1e-12):
+            peaks.append(h_max)
+        cycles = []
+        for peak in peaks:
+            if not self._load_leg(run, peak, targets):
                 break
-            a_last = hist.a_nodes[-1] if hist.a_nodes else 0.0
-            if targets is not None:
-                ahead = targets[targets > h * (1 + 1e-12)]
-                dh = min(dh, (ahead[0] if ahead.size else h_max) - h)
-            else:
-                dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
-            h_new = h + dh
-            if u_prev is None:
-                u_pred = u.copy()
-                # rigid translation by dh/2: its intersection radius √(R dh) is Hertz's a
-                u_pred[1::2] -= 0.5 * dh
-            else:  # secant predictor
-                u_pred = u + (dh / dh_prev) * (u - u_prev)
-            u_pred[2 * self.hmesh.equator + 1] = -h_new
-            u_pred[2 * self.hmesh.axis] = 0.0
-            try:
-                u_new, upd, act, its, changes, res_hist, f, gap, lam, normal = self._newton(
-                    u_pred, h_new, state, active.copy())
-            except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
-                self.rejected.append((h_new, dh, str(err)))
-                dh *= 0.5
-                if dh < opt.dh_min * R:
-                    status = "stopped"
-                    reason = (f"increment below dh_min = {opt.dh_min:g} R at h/R = {h / R:.6g}: {err}")
+            if unload.size and np.any(np.abs(unload - peak) <= 1e-12 * R):
+                cycle = self._unload_leg(run)
+                if cycle is None:
                     break
-                continue
-            # ---- commit
-            diss_inc = plastic_dissipation(self.disc, self.material, state.eps_p, upd.dgamma)
-            state = PlasticState(upd.cp_inv, upd.eps_p, state.dissipation + diss_inc)
-            u_prev, u, dh_prev, active = u, u_new, dh, act
-            h = h_new
-            F_support = -float(f[2 * self.hmesh.equator + 1].sum())
-            xs = self.X[:, self.surface] + self._nodal(u, self.surface)
-            F = float(np.sum(lam * normal[1]))
-            if self.segments is not None:
-                F = float(self._points[4][1].sum())
-            areas = surface_areas(self.X[:, self.arc] + self._nodal(u, self.arc))[:-1]
-            pressure = np.where(active, lam / areas, 0.0)
-            a_nodes, a_sub, a_ref = contact_edge(self.X[0, self.surface], xs[0], gap, active)
-            if self.segments is not None:  # where the gap of the points crosses zero
-                a_ref = self.segments.contact_radius(self._points[0])
-                a_sub = float(np.interp(a_ref, self.X[0, self.surface], xs[0]))
-            work += work_increment(h - dh, h, F_last, F)
-            F_last = F
-            hist.h.append(h)
-            hist.F.append(F)
-            hist.F_support.append(F_support)
-            hist.a.append(a_sub)
-            hist.a_nodes.append(a_nodes)
-            hist.a_ref.append(a_ref)
-            hist.eps_p_max.append(float(state.eps_p.max()))
-            hist.penetration.append(float(max(-gap.min(initial=0.0), 0.0)))
-            hist.work_external.append(work)
-            hist.energy_elastic.append(self.disc.integrate(upd.psi))
-            hist.dissipation.append(state.dissipation)
-            hist.iterations.append(its)
-            hist.active_changes.append(changes)
-            hist.residuals.append(res_hist)
-            hist.profile_r.append(xs[0].copy())
-            hist.profile_p.append(pressure)
-            # penalty contact: the closed nodes' gap is their penetration
-            hist.profile_g.append(gap if self.k_penalty is not None else np.where(active, 0.0, gap))
-            if progress is not None:
-                progress(h)
-            if targets is not None:
-                dh = np.inf
-            elif its <= opt.easy_iterations:
-                dh *= opt.growth
-        wall = time.perf_counter() - t_start
+                cycles.append(cycle)
+        status, reason = run.status, run.reason
+        u, state = run.u, run.state
+        wall = time.perf_counter() - run.t_start
         curves = {k: np.asarray(getattr(hist, k), dtype=float) for k in (
             "h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max", "work_external",
-            "energy_elastic", "dissipation", "iterations", "active_changes")}
+            "energy_elastic", "dissipation", "iterations", "active_changes", "branch")}
         if self.k_penalty is not None:  # largest penetration of the penalty contact
             curves["penetration"] = np.asarray(hist.penetration, dtype=float)
         finish_curves(curves)  # a: sub-element estimates smoothed over increments
@@ -603,6 +827,7 @@ class IndentationSolver:
                   "element": self.disc.element,
                   "n_elements": self.disc.n_elements, "n_dofs": self._nd,
                   "options": self.options.as_inputs()}
+        inputs["unload_at"] = [float(x) for x in unload]
         return RunResult(inputs=inputs, curves=curves, residuals=hist.residuals,
                          profile_r=prof_r, profile_p=prof_p, profile_g=prof_g, status=status, reason=reason,
-                         timings=timings, final=final)
+                         timings=timings, final=final, cycles=cycles_as_arrays(cycles, self.surface.size))

@@ -36,6 +36,7 @@ import scipy.sparse.linalg as spla
 from ..model.material import Material
 from .assembly import Discretisation, positive_jacobian
 from .contact import contact_edge, surface_areas
+from .linsolve import SymmetricSolver
 from .mesh import REVERSED, build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segments import N_COORDS, gap_gradient, gap_hessian
@@ -251,6 +252,7 @@ class TwoBodySolver:
         self.free = np.ones(self.n_dofs, dtype=bool)
         self.free[self.fixed] = False
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+        self.linear = SymmetricSolver(self.options.linear_solver)
 
     # ------------------------------------------------------------------ bodies
     def _stress(self, u, states, known=None):
@@ -421,7 +423,7 @@ class TwoBodySolver:
             t3 = time.perf_counter()
             self.timers["contact"] += t3 - t2
             du = np.zeros(self.n_dofs)
-            du[free] = spla.splu(K[free][:, free].tocsc(), permc_spec="COLAMD").solve(-r[free])
+            du[free] = self.linear.solve(K[free][:, free], -r[free])  # symmetric: LDLᵀ, SuperLU fallback
             u, known, kins = self._line_search(u, du, f, kins, states, self._penalty_force)
             self.timers["solve"] += time.perf_counter() - t3
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
@@ -469,6 +471,7 @@ class TwoBodySolver:
         t_start = time.perf_counter()
         for k in self.timers:
             self.timers[k] = 0.0
+        self.linear = SymmetricSolver(self.options.linear_solver)
         self.rejected = []
         u = np.zeros(self.n_dofs)
         u_prev = None
@@ -551,6 +554,7 @@ class TwoBodySolver:
         curves = finish_curves({k: np.asarray(v, dtype=float) for k, v in rec.items()})
         n = self.candidates.size
         timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
+                   **{f"linear_{k}": v for k, v in self.linear.stats.items()},
                    "increments": int(curves["h"].size), "newton_iterations": int(curves["iterations"].sum()),
                    "rejected_increments": len(self.rejected)}
         b1, b2 = self.bodies

@@ -1,0 +1,290 @@
+"""Verification of unloading and reloading cycles (one sphere on a rigid flat, ν = 0.3).
+
+Runs (``--out`` gets ``cycles.md``, ``cycles_verification.json``, ``cycles.png``):
+
+* elastic sphere, cycles at h/R = 0.001, 0.01, 0.1, 0.3: unloading must retrace loading
+  (F within 0.1 %) and end at h_res = 0; its loading slope dF/dh is the elastic reference
+  for the unloading stiffness of the plastic spheres;
+* EPP E/σY = 200 and 1000, the same cycles: initial unloading stiffness S = dF/dh at h_max
+  against Sneddon's 2E*a (any axisymmetric punch on a half-space; Sneddon 1965, Int. J.
+  Eng. Sci. 3:47), E* = E/(1 − ν²) against a rigid flat, a the loaded contact radius;
+  reloading elastic up to h_max (no dissipation), then back on the monotone curve;
+  energy per cycle: work in − work returned = dissipation + change of stored energy;
+* EPP E/σY = 200 monotone (cost of a cycle; the curve the reloads must rejoin);
+* EPP E/σY = 200 to h/R = 0.1 on a 2× mesh and with half increments (loading strain
+  increment and unloading increments): h_res and the unloading curves within 1 %;
+* Thornton (1997, J. Appl. Mech. 64:383): Hertzian unloading with the residual radius
+  R_p = 4E*a_max³/(3F_max), h_res = h_max − (3F_max/(4E*√R_p))^{2/3},
+  F = (4/3)E*√R_p (h − h_res)^{3/2}: a sanity check beside the FE, not a reference.
+
+``python -m spherecontact.fem.verification_cycles --out reports/fem`` (~10 min on 2 cores).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from ..model.material import Material
+from ..validation.metrics import scatter
+from .solver import LOAD, RELOAD, UNLOAD, IndentationSolver, SolverOptions
+
+NU = 0.3
+CYCLES_AT = (0.001, 0.01, 0.1, 0.3)
+#: name → (E/σY (inf: elastic), h_max, unload_at, mesh density, strain increment, unload increments)
+RUNS = {
+    "elastic": (math.inf, 0.3, CYCLES_AT, 1.0, 0.005, 24),
+    "E200": (200.0, 0.3, CYCLES_AT, 1.0, 0.005, 24),
+    "E1000": (1000.0, 0.3, CYCLES_AT, 1.0, 0.005, 24),
+    "E200_monotone": (200.0, 0.3, None, 1.0, 0.005, 24),
+    "E200_mesh2": (200.0, 0.1, CYCLES_AT[:3], 2.0, 0.005, 24),
+    "E200_half_increment": (200.0, 0.1, CYCLES_AT[:3], 1.0, 0.0025, 48),
+}
+LIMITS = {"elastic_retrace": 0.001, "energy": 0.01, "convergence": 0.01, "sneddon_small": 0.02,
+          "cycle_cost": 0.20}
+
+
+def run_case(name: str) -> dict:
+    """One FE run of :data:`RUNS`, as plain arrays."""
+    ratio, h_max, unload, density, strain_inc, n_unload = RUNS[name]
+    material = Material(E=200.0, nu=NU, sigma_y=math.inf) if math.isinf(ratio) else \
+        Material(E=ratio, nu=NU, sigma_y=1.0)
+    solver = IndentationSolver(material, 1.0, density=density,
+                               options=SolverOptions(strain_increment=strain_inc, unload_increments=n_unload))
+    res = solver.run(h_max, unload_at=unload)
+    keep = ("h", "F", "a", "a_ref", "branch", "dissipation", "work_external", "energy_elastic")
+    return {"name": name, "E": material.E, "status": res.status, "wall_s": res.timings["wall_s"],
+            "increments": res.timings["increments"], "n_dofs": solver.disc.n_dofs,
+            "curves": {k: np.asarray(res.curves[k]).tolist() for k in keep},
+            "cycles": {k: np.asarray(v).tolist() for k, v in res.cycles.items()
+                       if not k.startswith("profile")}}
+
+
+def _arrays(run: dict) -> dict:
+    return {k: np.asarray(v) for k, v in run["curves"].items()}
+
+
+def _branch(c: dict, cyc: dict, i: int):
+    """(loading part, unloading part) of cycle i as index arrays."""
+    i0, ip, ie = (int(cyc[k][i]) for k in ("increment_start", "increment_peak", "increment_end"))
+    return np.arange(i0, ip + 1), np.arange(ip, ie + 1)
+
+
+def _loglog_interp(x, xp, yp):
+    """Interpolation of y(x) linear in ln x, ln y (exact for power laws)."""
+    order = np.argsort(xp)
+    return np.exp(np.interp(np.log(x), np.log(xp[order]), np.log(yp[order])))
+
+
+def unloading_stiffness(h: np.ndarray, F: np.ndarray) -> float:
+    """dF/dh at the first point of an unloading branch: quadratic through its first 4 points."""
+    p = np.polyfit(h[:4] - h[0], F[:4], 2)
+    return float(p[1])
+
+
+def elastic_slope(c: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(a/R, dF/dh) along the monotone loading of the elastic run (d ln F/d ln h · F/h)."""
+    load = np.flatnonzero((c["branch"] == LOAD) & (c["h"] > 0))
+    h, F, a = c["h"][load], c["F"][load], c["a"][load]
+    slope = np.gradient(np.log(F), np.log(h)) * F / h
+    return a, slope
+
+
+def thornton(h_max: float, F_max: float, a_max: float, E_star: float, h: np.ndarray):
+    """Thornton (1997): (h_res, F on unloading at h)."""
+    Rp = 4.0 * E_star * a_max**3 / (3.0 * F_max)
+    h_res = h_max - (3.0 * F_max / (4.0 * E_star * math.sqrt(Rp))) ** (2.0 / 3.0)
+    return h_res, 4.0 / 3.0 * E_star * math.sqrt(Rp) * np.maximum(h - h_res, 0.0) ** 1.5
+
+
+def analyse(runs: dict) -> dict:
+    out = {"limits": LIMITS, "runs": {n: {k: r[k] for k in ("status", "wall_s", "increments", "n_dofs")}
+                                      for n, r in runs.items()}}
+    E_star = {n: r["E"] / (1 - NU**2) for n, r in runs.items()}
+    # 1. elastic retrace and h_res
+    el, elc = _arrays(runs["elastic"]), runs["elastic"]["cycles"]
+    retrace = []
+    for i, hm in enumerate(elc["h_max"]):
+        load, unl = _branch(el, elc, i)
+        sel = unl[el["F"][unl] > 0.05 * elc["F_max"][i]]
+        ref = _loglog_interp(el["h"][sel], el["h"][load][el["F"][load] > 0], el["F"][load][el["F"][load] > 0])
+        retrace.append({"h_max": hm, "F_max_dev": float(np.max(np.abs(el["F"][sel] / ref - 1))),
+                        "h_res_over_h_max": elc["h_res"][i] / hm})
+    out["elastic"] = retrace
+    # 2. unloading stiffness against Sneddon, beside the elastic sphere's own slope
+    a_el, S_el = elastic_slope(el)
+    order = np.argsort(a_el)
+    stiff = []
+    for name in ("elastic", "E200", "E1000"):
+        c, cyc = _arrays(runs[name]), runs[name]["cycles"]
+        for i, hm in enumerate(cyc["h_max"]):
+            _, unl = _branch(c, cyc, i)
+            S = unloading_stiffness(c["h"][unl], c["F"][unl])
+            a = c["a"][unl[0]]
+            sneddon = 2.0 * E_star[name] * a
+            own = float(np.interp(a, a_el[order], S_el[order])) / (2.0 * E_star["elastic"] * a)
+            stiff.append({"run": name, "h_max": hm, "a_over_R": float(a), "S_over_2Ea": S / sneddon,
+                          "elastic_sphere_dFdh_over_2Ea": own})
+    out["stiffness"] = stiff
+    # 3. reloading: elastic until h_max, then the monotone curve
+    mono = _arrays(runs["E200_monotone"])
+    noise = scatter(mono["h"], mono["F"], mono["h"] >= 0.01)
+    reload = []
+    for name in ("E200", "E1000"):
+        c, cyc = _arrays(runs[name]), runs[name]["cycles"]
+        for i, hm in enumerate(cyc["h_max"][:-1]):
+            _, unl = _branch(c, cyc, i)
+            rel = np.arange(unl[-1] + 1, c["h"].size)
+            rel = rel[:np.argmax(np.append(c["branch"][rel] != RELOAD, True))]  # this cycle's reload
+            if rel.size < 3:
+                continue
+            up = c["F"][rel]
+            down = np.interp(c["h"][rel], c["h"][unl][::-1], c["F"][unl][::-1])
+            top = (c["F"][rel] > 0.05 * cyc["F_max"][i])
+            entry = {"run": name, "h_max": hm,
+                     "reload_vs_unload_max_dev_over_F_max": float(np.max(np.abs(up - down)[top]) / cyc["F_max"][i]),
+                     "reload_dissipation_over_cycle": float((c["dissipation"][rel[-1]] - c["dissipation"][rel[0]])
+                                                            / max(cyc["dissipation"][i], 1e-300))}
+            if name == "E200":
+                after = np.flatnonzero((c["branch"] == LOAD) & (c["h"] > hm * 1.05)
+                                       & (c["h"] < (cyc["h_max"][i + 1] if i + 1 < len(cyc["h_max"]) else 1)))
+                if after.size:
+                    ref = _loglog_interp(c["h"][after], mono["h"][mono["h"] > 0], mono["F"][mono["h"] > 0])
+                    entry["rejoin_max_dev"] = float(np.max(np.abs(c["F"][after] / ref - 1)))
+                    entry["monotone_scatter"] = noise
+            reload.append(entry)
+    out["reload"] = reload
+    # 4. energy per cycle
+    energy = []
+    for name in ("elastic", "E200", "E1000"):
+        cyc = runs[name]["cycles"]
+        for i, hm in enumerate(cyc["h_max"]):
+            lhs = cyc["work_in"][i] - cyc["work_returned"][i]
+            rhs = cyc["dissipation"][i] + cyc["elastic_energy_change"][i]
+            energy.append({"run": name, "h_max": hm, "work_in": cyc["work_in"][i], "net_work": lhs,
+                           "dissipation_plus_stored": rhs, "error_over_work_in": abs(lhs - rhs) / cyc["work_in"][i]})
+    out["energy"] = energy
+    # 5. mesh and increment convergence of h_res and of the unloading curves
+    base, bc = _arrays(runs["E200"]), runs["E200"]["cycles"]
+    conv = []
+    for name in ("E200_mesh2", "E200_half_increment"):
+        c, cyc = _arrays(runs[name]), runs[name]["cycles"]
+        for i, hm in enumerate(cyc["h_max"]):
+            _, ub = _branch(base, bc, i)
+            _, uc = _branch(c, cyc, i)
+            Fi = np.interp(base["h"][ub][::-1], c["h"][uc][::-1], c["F"][uc][::-1])[::-1]
+            conv.append({"run": name, "h_max": hm, "h_res_dev": cyc["h_res"][i] / bc["h_res"][i] - 1,
+                         "unloading_F_max_dev_over_F_max":
+                             float(np.max(np.abs(Fi - base["F"][ub])) / bc["F_max"][i])})
+    out["convergence"] = conv
+    # 6. Thornton's residual approach and unloading curve beside the FE
+    th = []
+    for name in ("E200", "E1000"):
+        c, cyc = _arrays(runs[name]), runs[name]["cycles"]
+        for i, hm in enumerate(cyc["h_max"]):
+            _, unl = _branch(c, cyc, i)
+            h_res_t, F_t = thornton(hm, cyc["F_max"][i], cyc["a_max"][i], E_star[name], c["h"][unl])
+            th.append({"run": name, "h_max": hm, "h_res_over_h_max_fe": cyc["h_res"][i] / hm,
+                       "h_res_over_h_max_thornton": h_res_t / hm,
+                       "F_max_dev_over_F_max": float(np.max(np.abs(F_t - c["F"][unl])) / cyc["F_max"][i])})
+    out["thornton"] = th
+    # 7. cost of the cycles
+    w_cyc, w_mono = runs["E200"]["wall_s"], runs["E200_monotone"]["wall_s"]
+    out["cost"] = {"wall_with_4_cycles_s": w_cyc, "wall_monotone_s": w_mono,
+                   "added_per_cycle": (w_cyc / w_mono - 1) / len(CYCLES_AT)}
+    return out
+
+
+def chart(runs: dict, path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for ax, name in zip(axes, ("E200", "E1000"), strict=True):
+        c = _arrays(runs[name])
+        for b, col, lab in ((LOAD, "k", "load"), (UNLOAD, "tab:red", "unload"), (RELOAD, "tab:blue", "reload")):
+            m = c["branch"] == b
+            ax.plot(c["h"][m], c["F"][m], ".", ms=2, color=col, label=lab)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("h/R")
+        ax.set_ylabel("F/(σY R²)")
+        ax.set_title(f"EPP E/σY = {name[1:]}: cycles at h/R = {', '.join(f'{x:g}' for x in CYCLES_AT)}")
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:.2f}"
+
+
+def report(res: dict) -> str:
+    lines = ["# Unloading and reloading cycles (one sphere on a rigid flat, ν = 0.3)", "",
+             "`python -m spherecontact.fem.verification_cycles` — " + __doc__.splitlines()[0], ""]
+    lines += ["## Runs", "", "| run | status | increments | dofs | wall s |", "|---|---|---|---|---|"]
+    lines += [f"| {n} | {r['status']} | {r['increments']} | {r['n_dofs']} | {r['wall_s']:.0f} |"
+              for n, r in res["runs"].items()]
+    lines += ["", "## Elastic sphere: unloading retraces loading", "",
+              "| h_max/R | max dev of F on unloading (F > 5 % F_max) % | h_res/h_max |", "|---|---|---|"]
+    lines += [f"| {e['h_max']:g} | {_pct(e['F_max_dev'])} | {e['h_res_over_h_max']:.2e} |" for e in res["elastic"]]
+    lines += ["", "## Initial unloading stiffness against Sneddon's 2E*a", "",
+              "S = dF/dh at h_max (quadratic through the first four unloading points); the elastic "
+              "sphere's own loading slope at the same a/R beside it.", "",
+              "| run | h_max/R | a/R | S/(2E*a) | elastic sphere dF/dh/(2E*a) |", "|---|---|---|---|---|"]
+    lines += [f"| {s['run']} | {s['h_max']:g} | {s['a_over_R']:.4f} | {s['S_over_2Ea']:.3f} | "
+              f"{s['elastic_sphere_dFdh_over_2Ea']:.3f} |" for s in res["stiffness"]]
+    lines += ["", "## Reloading", "",
+              "| run | h_max/R | reload vs unload, max |ΔF|/F_max % | dissipation while reloading / cycle's | "
+              "after h_max: max dev from the monotone run % (its scatter %) |", "|---|---|---|---|---|"]
+    for r in res["reload"]:
+        rej = (f"{_pct(r['rejoin_max_dev'])} ({_pct(r['monotone_scatter'])})" if "rejoin_max_dev" in r else "—")
+        lines.append(f"| {r['run']} | {r['h_max']:g} | {_pct(r['reload_vs_unload_max_dev_over_F_max'])} | "
+                     f"{r['reload_dissipation_over_cycle']:.2e} | {rej} |")
+    lines += ["", "## Energy per cycle", "",
+              "| run | h_max/R | work in − returned | dissipation + Δ stored | error / work in % |",
+              "|---|---|---|---|---|"]
+    lines += [f"| {e['run']} | {e['h_max']:g} | {e['net_work']:.4e} | {e['dissipation_plus_stored']:.4e} | "
+              f"{_pct(e['error_over_work_in'])} |" for e in res["energy"]]
+    lines += ["", "## Mesh and increment convergence (E/σY = 200)", "",
+              "| run | h_max/R | h_res vs default % | unloading F max |ΔF|/F_max % |", "|---|---|---|---|"]
+    lines += [f"| {c['run']} | {c['h_max']:g} | {_pct(c['h_res_dev'])} | {_pct(c['unloading_F_max_dev_over_F_max'])} |"
+              for c in res["convergence"]]
+    lines += ["", "## Thornton (1997) beside the FE", "",
+              "| run | h_max/R | h_res/h_max FE | Thornton | unloading F max |ΔF|/F_max % |", "|---|---|---|---|---|"]
+    lines += [f"| {t['run']} | {t['h_max']:g} | {t['h_res_over_h_max_fe']:.3f} | {t['h_res_over_h_max_thornton']:.3f}"
+              f" | {_pct(t['F_max_dev_over_F_max'])} |" for t in res["thornton"]]
+    c = res["cost"]
+    lines += ["", "## Cost", "", f"E/σY = 200 to h/R = 0.3: {c['wall_monotone_s']:.0f} s monotone, "
+              f"{c['wall_with_4_cycles_s']:.0f} s with 4 cycles: {_pct(c['added_per_cycle'])} % per cycle.", "",
+              "![cycles](cycles.png)", ""]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="reports/fem")
+    ap.add_argument("--workers", type=int, default=2)
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    names = sorted(RUNS, key=lambda n: -RUNS[n][3] * RUNS[n][1])  # longest first
+    with ProcessPoolExecutor(args.workers) as pool:
+        runs = dict(zip(names, pool.map(run_case, names), strict=True))
+    res = analyse(runs)
+    (out / "cycles_verification.json").write_text(json.dumps(res, indent=1) + "\n")
+    chart(runs, out / "cycles.png")
+    (out / "cycles.md").write_text(report(res))
+    print(report(res))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

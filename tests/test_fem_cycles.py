@@ -1,0 +1,110 @@
+"""Unloading and reloading cycles of the FE solver (fem/solver.py ``unload_at``)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from spherecontact.cli import main
+from spherecontact.fem import read_run, run_indentation, write_run
+from spherecontact.fem.solver import (
+    LOAD,
+    RELOAD,
+    UNLOAD,
+    IndentationSolver,
+    check_unload_at,
+    pole_radius,
+    quadratic_work,
+    residual_approach,
+)
+from spherecontact.model import Material
+
+ELASTIC = Material(E=200.0, nu=0.3, sigma_y=math.inf)
+EPP = Material(E=200.0, nu=0.3, sigma_y=1.0)
+
+
+@pytest.fixture(scope="module")
+def elastic_run():
+    return IndentationSolver(ELASTIC, 1.0, density=0.5).run(0.004, unload_at=[0.002, 0.004])
+
+
+@pytest.fixture(scope="module")
+def plastic_run():
+    return IndentationSolver(EPP, 1.0, density=0.5).run(0.012, unload_at=[0.006, 0.01])
+
+
+@pytest.mark.parametrize("bad, message", [
+    ([0.0, 0.1], r"\(0, h_max\]"), ([0.1, 0.4], r"\(0, h_max\]"), ([0.2, 0.1], "strictly increasing"),
+    ([], "non-empty"), ([float("nan")], "finite"),
+])
+def test_bad_schedules_are_named(bad, message):
+    with pytest.raises(ValueError, match="unload_at") as err:
+        check_unload_at(bad, 0.3)
+    assert err.match(message)
+
+
+def test_helpers_against_closed_forms():
+    h = np.array([0.9, 0.8])
+    assert residual_approach(h, 3.0 * (h - 0.35) ** 1.5) == pytest.approx(0.35, rel=1e-12)
+    r = np.linspace(0.0, 0.2, 9)
+    assert pole_radius(r, 5.0 - np.sqrt(5.0**2 - r**2) + 0.1, 0.2) == pytest.approx(5.0, rel=2e-3)
+    assert quadratic_work(0.0, 1.0, 2.0, 0.0, 1.0, 4.0) == pytest.approx(7.0 / 3.0, rel=1e-12)  # ∫₁² h² dh
+
+
+def test_elastic_unloading_retraces_loading(elastic_run):
+    r = elastic_run
+    c, cyc = r.curves, r.cycles
+    assert set(np.unique(c["branch"])) == {LOAD, UNLOAD, RELOAD}
+    assert cyc["h_max"].tolist() == pytest.approx([0.002, 0.004])
+    # elastic: no residual dent (to within the last contact ring of this coarse pole mesh)
+    assert np.all(cyc["h_res"] / cyc["h_max"] < 0.03)
+    ip, ie = int(cyc["increment_peak"][1]), int(cyc["increment_end"][1])
+    load = np.flatnonzero(c["branch"] == LOAD)
+    up = np.arange(ip, ie + 1)
+    sel = up[c["F"][up] > 0.05 * cyc["F_max"][1]]
+    ref = np.exp(np.interp(np.log(c["h"][sel]), np.log(c["h"][load]), np.log(c["F"][load])))
+    assert np.max(np.abs(c["F"][sel] / ref - 1)) < 0.01
+    balance = (cyc["work_in"] - cyc["work_returned"]) / cyc["work_in"]
+    assert np.all(np.abs(balance) < 2e-3) and np.all(cyc["dissipation"] == 0.0)
+
+
+def test_plastic_cycle_leaves_a_dent_and_reloads_elastically(plastic_run):
+    r = plastic_run
+    c, cyc = r.curves, r.cycles
+    assert r.status == "converged" and cyc["h_max"].size == 2
+    ratio = cyc["h_res"] / cyc["h_max"]
+    assert np.all((ratio > 0.3) & (ratio < 0.95)) and ratio[1] > ratio[0]
+    assert np.all(cyc["dissipation"] > 0) and np.all(cyc["pole_radius"] > 1.0)  # flattened pole
+    lhs = cyc["work_in"] - cyc["work_returned"]
+    rhs = cyc["dissipation"] + cyc["elastic_energy_change"]
+    assert np.all(np.abs(lhs / rhs - 1) < 0.02)
+    first = np.arange(int(cyc["increment_start"][1]), int(cyc["increment_peak"][1]))
+    first = first[c["branch"][first] == RELOAD]  # the reload that opens the second cycle
+    assert first.size > 3  # elastic reloading up to h_max: no new dissipation
+    assert c["dissipation"][first].max() - c["dissipation"][first].min() < 0.01 * cyc["dissipation"][0]
+    assert c["h"][-1] == pytest.approx(0.012) and c["branch"][-1] == LOAD
+
+
+def test_cycles_survive_the_run_file(plastic_run, tmp_path):
+    path = write_run(tmp_path / "run.h5", plastic_run)
+    back = read_run(path)
+    assert np.array_equal(back.branch, plastic_run.curves["branch"])
+    assert np.allclose(back.cycles["h_res"], plastic_run.cycles["h_res"])
+    assert back.cycles["profile_z"].shape == (2, back.profile_r.shape[1])
+
+
+def test_equal_pair_doubles_the_approaches_and_two_bodies_are_refused():
+    res = run_indentation(EPP, 1.0, 0.012, radius2=1.0, material2=EPP, density=0.5, unload_at=[0.012])
+    assert res.inputs["scene"] == "equal_pair_symmetry"
+    assert res.cycles["h_max"][0] == pytest.approx(0.012)
+    assert 0.3 < res.cycles["h_res"][0] / 0.012 < 0.95
+    with pytest.raises(ValueError, match="two deformable bodies"):
+        run_indentation(EPP, 1.0, 0.01, radius2=2.0, material2=Material(E=600.0, nu=0.3, sigma_y=1.0),
+                        unload_at=[0.01])
+
+
+def test_cli_rejects_a_bad_schedule_before_any_work(tmp_path, capsys):
+    code = main(["fem", "run", "--E", "200", "--h-max", "0.02", "--unload-at", "0.03",
+                 "--out", str(tmp_path / "x.h5")])
+    assert code == 2 and "unload_at" in capsys.readouterr().err
+    assert not (tmp_path / "x.h5").exists()
