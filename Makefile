@@ -7,7 +7,7 @@ export OMP_NUM_THREADS ?= 1
 export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
-.PHONY: test bench lint verify-fem verify-pair demo clean
+.PHONY: test bench lint verify-fem verify-pair verify-cycles verify-smoothness demo clean
 .PHONY: fem
 .PHONY: validate
 .PHONY: calibrate
@@ -34,6 +34,12 @@ calibrate: $(STAMP)
 
 verify-fem: $(STAMP)
 	$(PY) -m spherecontact.fem.verification --out reports/fem
+
+verify-cycles: $(STAMP)
+	$(PY) -m spherecontact.fem.verification_cycles --out reports/fem
+
+verify-smoothness: $(STAMP)
+	$(PY) -m spherecontact.fem.smoothness --out reports/fem
 
 verify-pair: $(STAMP)
 	$(PY) -m spherecontact.fem.verification_pair --out reports/fem

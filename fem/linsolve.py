@@ -33,6 +33,11 @@ except ImportError:  # pragma: no cover - exercised only where the wheel is miss
 RTOL = 1e-8
 
 
+def _pattern_of(A: sp.csc_matrix) -> tuple:
+    """Hashable sparsity pattern of a sorted CSC matrix (index dtypes normalised)."""
+    return (A.shape, A.indptr.astype(np.int64).tobytes(), A.indices.astype(np.int64).tobytes())
+
+
 def superlu_solve(K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
     """x with K x = b by SuperLU (MMD on Kᵀ + K, symmetric mode: diagonal pivots preferred)."""
     lu = spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
@@ -57,20 +62,49 @@ class SymmetricSolver:
         self.rtol = float(rtol)
         self._solver = None
         self._pattern = None
+        self._keys, self._rows, self._indptr, self._n = None, None, None, 0
         self.stats = {"ldl_fresh": 0, "ldl_update": 0, "fallback": 0, "superlu": 0}
         self.times = {"factorisation": 0.0, "solve": 0.0}
 
     def _factor(self, K: sp.csc_matrix) -> None:
+        """Factor K. The stored pattern only grows: a matrix whose entries lie inside it is
+        refactored on the stored analysis (its missing entries as zeros); one with new entries
+        gets a fresh analysis of the union, so a contact whose pairs move settles on one."""
         upper = sp.triu(K, format="csc")
         upper.sort_indices()
-        pattern = (upper.shape, upper.indptr.tobytes(), upper.indices.tobytes())
+        pattern = _pattern_of(upper)
         if self._solver is not None and pattern == self._pattern:
             self._solver.update(upper, upper=True)
             self.stats["ldl_update"] += 1
-        else:
-            self._solver = qdldl.Solver(upper, upper=True)
-            self._pattern = pattern
-            self.stats["ldl_fresh"] += 1
+            return
+        n = upper.shape[0]
+        cols = np.repeat(np.arange(n, dtype=np.int64), np.diff(upper.indptr))
+        keys = cols * n + upper.indices
+        if self._solver is not None and self._keys is not None and n == self._n:
+            pos = np.searchsorted(self._keys, keys)
+            inside = pos < self._keys.size
+            inside[inside] = self._keys[pos[inside]] == keys[inside]
+            if inside.all():
+                data = np.zeros(self._keys.size)
+                data[pos] = upper.data
+                self._solver.update(self._matrix(data), upper=True)
+                self.stats["ldl_update"] += 1
+                return
+            keys = np.union1d(self._keys, keys)
+        self._keys = np.asarray(keys, dtype=np.int64)
+        self._n = n
+        cols_u, self._rows = np.divmod(self._keys, n)
+        self._indptr = np.concatenate([[0], np.cumsum(np.bincount(cols_u, minlength=n))])
+        data = np.zeros(self._keys.size)
+        data[np.searchsorted(self._keys, cols * n + upper.indices)] = upper.data
+        full = self._matrix(data)
+        self._solver = qdldl.Solver(full, upper=True)
+        self._pattern = _pattern_of(full)
+        self.stats["ldl_fresh"] += 1
+
+    def _matrix(self, data: np.ndarray) -> sp.csc_matrix:
+        """Upper-triangular CSC matrix of the stored pattern holding ``data``."""
+        return sp.csc_matrix((data, self._rows, self._indptr), shape=(self._n, self._n))
 
     def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
         """x with K x = b; LDLᵀ where it is accurate, SuperLU otherwise."""
@@ -89,7 +123,7 @@ class SymmetricSolver:
                 if ok:
                     return x
             except (ValueError, RuntimeError):
-                self._solver, self._pattern = None, None  # a failed factorisation is not reused
+                self._solver, self._pattern, self._keys = None, None, None  # not reused after a failure
             self.stats["fallback"] += 1
             t0 = time.perf_counter()
         else:

@@ -28,6 +28,24 @@ def test_ldl_reuses_its_analysis_and_matches_superlu():
     assert s.stats == {"ldl_fresh": 1, "ldl_update": 1, "fallback": 0, "superlu": 0}
 
 
+def test_a_moving_pattern_settles_on_the_union_of_the_patterns_seen():
+    """Contact couplings that come and go (two-body penalty contact): a matrix inside the stored
+    pattern reuses its analysis, new entries trigger one fresh analysis of the union."""
+    K = _laplacian(10)
+    n = K.shape[0]
+    b = np.ones(n)
+
+    def coupled(i, j):
+        E = sp.csr_matrix(([0.5, 0.5], ([i, j], [j, i])), shape=(n, n))
+        return (K + E).tocsr()
+
+    s = SymmetricSolver("ldl")
+    for A in (coupled(3, 40), coupled(7, 60), coupled(3, 40), K, coupled(7, 60)):
+        x = s.solve(A, b)
+        assert np.abs(A @ x - b).max() < 1e-10
+    assert s.stats["ldl_fresh"] == 2 and s.stats["ldl_update"] == 3 and s.stats["fallback"] == 0
+
+
 def test_saddle_point_falls_back_to_superlu():
     """A zero pivot (Lagrange-multiplier block) defeats LDLᵀ without pivoting: SuperLU answers."""
     A = _laplacian(4)
