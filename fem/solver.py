@@ -607,6 +607,12 @@ class IndentationSolver:
             a_sub = float(np.interp(a_ref, self.X[0, self.surface], xs[0]))
         if branch == LOAD:
             run.work += work_increment(run.h, h_new, run.F, F)
+            if len(hist.h) == 1 and run.F > 0 and F > run.F:
+                # the first increment assumed Hertz's exponent 3/2: use the one measured now
+                p = np.log(F / run.F) / np.log(h_new / run.h)
+                first = run.F * run.h / (p + 1.0)
+                run.work += first - hist.work_external[0]
+                hist.work_external[0] = first
         elif hist.branch and hist.branch[-1] == branch and len(hist.h) >= 2:
             # unloading and elastic reloading: the parabola through this and the last two points
             run.work += quadratic_work(hist.h[-2], run.h, h_new, hist.F[-2], run.F, F)

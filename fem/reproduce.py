@@ -1,0 +1,70 @@
+"""Does the current solver reproduce the stored reference curves? (one run per scene)
+
+Re-runs campaign cases of ``data/reference.h5`` with their stored inputs (the solver's
+numerics may have changed since: factorisation, Newton steps) and compares F and a with
+the stored curves at the stored approaches h/R ≥ 0.01 (log–log interpolation of the new
+curve): the systematic difference is the median of ln(new/stored), the largest one the
+maximum, beside the stored curve's own FE scatter (max |ln y − local quadratic| over 11
+increments). Two noisy curves may differ by up to the sum of their scatters.
+
+``python -m spherecontact.fem.reproduce --out reports/fem`` → ``reproduce.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..data import Database
+from ..validation.metrics import interp_loglog, scatter
+from .design import load_campaign
+from .io import run_indentation
+
+#: one case per scene: a flat, a rigid sphere, two bodies (exact contact)
+CASES = ("flat-pp-E200-nu0.35", "rsphere2-pp-E200-nu0.3", "two-pp-E200-nu0.3-vs-sy3")
+
+
+def compare(h_old, y_old, h_new, y_new, h_min: float) -> dict:
+    sel = (h_old >= h_min) & (h_old <= h_new.max()) & (y_old > 0)
+    dev = np.log(interp_loglog(h_old[sel], h_new[h_new > 0], y_new[h_new > 0]) / y_old[sel])
+    return {"systematic": float(np.median(dev)), "max": float(np.max(np.abs(dev))),
+            "stored_scatter": scatter(h_old, y_old, h_old >= h_min),
+            "new_scatter": scatter(h_new, y_new, h_new >= h_min)}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--db", default="data/reference.h5")
+    ap.add_argument("--campaign", default="data/campaign.toml")
+    ap.add_argument("--out", default="reports/fem")
+    ap.add_argument("--cases", nargs="*", default=list(CASES))
+    args = ap.parse_args(argv)
+    db = Database(args.db)
+    by_name = {c.name: c for c in load_campaign(args.campaign).cases}
+    results = []
+    for name in args.cases:
+        case = by_name[name]
+        stored = db.run(case.key)
+        R = min(case.inputs["radius"], case.inputs.get("radius2", np.inf))
+        new = run_indentation(**case.run_kwargs())
+        row = {"case": name, "status": new.status, "wall_s_new": new.timings["wall_s"],
+               "wall_s_stored": float(stored.provenance.get("wall_s", np.nan)),
+               "F": compare(stored.h, stored.F, new.h, new.F, 0.01 * R),
+               "a": compare(stored.h, stored.a, new.h, new.a, 0.01 * R)}
+        results.append(row)
+        F = row["F"]
+        print(f"{name}: F systematic {100 * F['systematic']:+.2f} %, max {100 * F['max']:.2f} % "
+              f"(stored scatter {100 * row['F']['stored_scatter']:.2f} %); a systematic "
+              f"{100 * row['a']['systematic']:+.2f} %, max {100 * row['a']['max']:.2f} %; "
+              f"{row['wall_s_new']:.0f} s (stored {row['wall_s_stored']:.0f} s)", flush=True)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "reproduce.json").write_text(json.dumps(results, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
