@@ -73,7 +73,7 @@ def chart(results: list[dict], path: Path) -> None:
                     xytext=(4, 2), textcoords="offset points")
     ax.axhline(0.5, color="grey", ls="--", lw=0.8)
     ax.set_xscale("log")
-    ax.set_xlabel("wall time to h/R = 0.3 [s] (one core)")
+    ax.set_xlabel("wall time to h/R = 0.3 [s]")
     ax.set_ylabel("FE scatter of F [%] (a/R ≥ 0.01)")
     ax.set_title("Smoothness of the FE force against its cost")
     fig.tight_layout()
