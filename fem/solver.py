@@ -314,7 +314,159 @@ class _RunState:
                                                       "energy_elastic": 0.0, "increment": 0})
 
 
-class IndentationSolver:
+class CycleLegs:
+    """Loading, unloading and elastic reloading legs of an incremental run (DESIGN §3b).
+
+    The solver provides ``options``, ``_length`` (its length scale), ``_hist`` (lists ``h``,
+    ``F``, ``a``, ``a_nodes``, ``work_external``, ``dissipation``, ``energy_elastic``,
+    ``branch``), ``_solve(run, h)`` (the converged increment or the exception),
+    ``_commit(run, h, solved, branch)``, ``_solved_contact(solved)`` → (F, any contact),
+    ``_pair_modulus()`` → E* and ``_residual_surface(u)`` → (r, z) of the contact surface.
+    """
+
+    def _walk(self, run: _RunState, h_max: float, unload: np.ndarray, targets=None) -> list[dict]:
+        """Load to each unloading approach, unload, reload; then load to h_max. The cycles."""
+        peaks = list(unload)
+        if not peaks or peaks[-1] < h_max * (1 - 1e-12):
+            peaks.append(h_max)
+        cycles = []
+        for peak in peaks:
+            if not self._load_leg(run, peak, targets):
+                break
+            if unload.size and np.any(np.abs(unload - peak) <= 1e-12 * self._length):
+                cycle = self._unload_leg(run)
+                if cycle is None:
+                    break
+                cycles.append(cycle)
+        return cycles
+
+    def _add_work(self, run: _RunState, h_new: float, F: float, branch: int) -> None:
+        """External work of the increment to h_new: power law through the end points on loading
+        (the first increment corrected with the exponent measured at the second), the parabola
+        through the last three points on unloading and reloading."""
+        hist = self._hist
+        if branch == LOAD:
+            run.work += work_increment(run.h, h_new, run.F, F)
+            if len(hist.h) == 1 and run.F > 0 and F > run.F:
+                p = np.log(F / run.F) / np.log(h_new / run.h)
+                first = run.F * run.h / (p + 1.0)
+                run.work += first - hist.work_external[0]
+                hist.work_external[0] = first
+        elif hist.branch and hist.branch[-1] == branch and len(hist.h) >= 2:
+            run.work += quadratic_work(hist.h[-2], run.h, h_new, hist.F[-2], run.F, F)
+        else:  # first interval of a branch
+            run.work += 0.5 * (run.F + F) * (h_new - run.h)
+
+    def _out_of_time(self, run: _RunState) -> bool:
+        if time.perf_counter() - run.t_start > self.options.max_wall_s:
+            run.status = "stopped"
+            run.reason = (f"wall-time limit of {self.options.max_wall_s:g} s reached at "
+                          f"h/R = {run.h / self._length:.6g}")
+            return True
+        return False
+
+    def _cut_back(self, run: _RunState, dh: float, err) -> bool:
+        """False (and the run stopped) when the halved increment falls below dh_min."""
+        if 0.5 * dh < self.options.dh_min * self._length:
+            run.status = "stopped"
+            run.reason = (f"increment below dh_min = {self.options.dh_min:g} R at "
+                          f"h/R = {run.h / self._length:.6g}: {err}")
+            return False
+        return True
+
+    def _load_leg(self, run: _RunState, peak: float, targets=None) -> bool:
+        """Load (elastic reloading first, below the largest approach reached) up to ``peak``."""
+        opt, R = self.options, self._length
+        while run.h < peak * (1 - 1e-12):
+            if self._out_of_time(run):
+                return False
+            if run.h < run.h_top * (1 - 1e-12):  # elastic reloading up to the previous maximum
+                dh, branch = min(run.dh_cycle, run.h_top - run.h), RELOAD
+            else:
+                a_last = self._hist.a_nodes[-1] if self._hist.a_nodes else 0.0
+                if targets is not None:
+                    ahead = targets[targets > run.h * (1 + 1e-12)]
+                    run.dh = min(run.dh, (ahead[0] if ahead.size else peak) - run.h)
+                else:
+                    run.dh = min(run.dh, peak - run.h, opt.dh_max * R,
+                                 max(opt.strain_increment * a_last, opt.dh_first * R))
+                dh, branch = run.dh, LOAD
+            solved = self._solve(run, run.h + dh)
+            if isinstance(solved, Exception):
+                if not self._cut_back(run, dh, solved):
+                    return False
+                if branch == RELOAD:
+                    run.dh_cycle *= 0.5
+                else:
+                    run.dh *= 0.5
+                continue
+            self._commit(run, run.h + dh, solved, branch)
+            if branch == LOAD:
+                if targets is not None:
+                    run.dh = np.inf
+                elif run.last_iterations <= opt.easy_iterations:
+                    run.dh *= opt.growth
+        return True
+
+    def _unload_leg(self, run: _RunState) -> dict | None:
+        """Unload from the current approach until the force vanishes; the cycle's summary.
+
+        Increments: about ``options.unload_increments`` over the elastic recovery estimated from
+        Sneddon's initial stiffness 2E*a, Δh ≈ 1.5 F_max/(2E*a). The last increment lands on
+        h_res, extrapolated from the last two points with F > 0 (:func:`residual_approach`).
+        """
+        hist, R = self._hist, self._length
+        i_peak = len(hist.h) - 1
+        h_peak, F_peak, a_peak = run.h, run.F, run.a
+        E_star = self._pair_modulus()
+        recovery = 1.5 * F_peak / (2.0 * E_star * a_peak) if a_peak > 0 else run.h
+        run.dh_cycle = max(min(recovery, run.h) / self.options.unload_increments, self.options.dh_min * R * 4)
+        run.u_prev = None
+        dh = run.dh_cycle
+        lost, h_lost = False, 0.0
+        while True:
+            if self._out_of_time(run):
+                return None
+            if not lost:
+                h_new = run.h - dh
+            elif len(hist.h) - i_peak >= 2:
+                h_new = min(max(residual_approach(np.array(hist.h[i_peak:]), np.array(hist.F[i_peak:])),
+                                h_lost), run.h)
+            else:
+                h_new = 0.5 * (run.h + h_lost)
+            if h_new <= 0.0:
+                h_new, lost = 0.0, True
+            solved = self._solve(run, h_new)
+            if isinstance(solved, Exception):
+                if not self._cut_back(run, dh, solved):
+                    return None
+                dh *= 0.5
+                continue
+            F_new, in_contact = self._solved_contact(solved)
+            if lost or (F_new > 1e-9 * F_peak and in_contact):
+                self._commit(run, h_new, solved, UNLOAD)
+                if lost or h_new == 0.0:
+                    break
+                continue
+            lost, h_lost = True, h_new  # contact lost between run.h and h_new: land on h_res next
+        base = run.cycle_base
+        i_end = len(hist.h) - 1
+        xs = self._residual_surface(run.u)
+        cycle = {"h_max": h_peak, "F_max": F_peak, "a_max": hist.a[i_peak], "h_res": run.h,
+                 "pole_radius": pole_radius(xs[0], xs[1], 0.5 * hist.a[i_peak]),
+                 "work_in": hist.work_external[i_peak] - base["work"],
+                 "work_returned": hist.work_external[i_peak] - hist.work_external[i_end],
+                 "dissipation": hist.dissipation[i_end] - base["dissipation"],
+                 "elastic_energy_change": hist.energy_elastic[i_end] - base["energy_elastic"],
+                 "increment_start": base["increment"], "increment_peak": i_peak, "increment_end": i_end,
+                 "profile_r": xs[0].copy(), "profile_z": xs[1].copy()}
+        run.cycle_base = {"work": hist.work_external[i_end], "dissipation": hist.dissipation[i_end],
+                          "energy_elastic": hist.energy_elastic[i_end], "increment": i_end + 1}
+        run.u_prev = None
+        return cycle
+
+
+class IndentationSolver(CycleLegs):
     """Hemisphere (radius R, material) on a rigid obstacle; call ``run(h_max)``."""
 
     def __init__(self, material: Material, radius: float = 1.0, obstacle: RigidObstacle | None = None,
@@ -587,6 +739,19 @@ class IndentationSolver:
             return float(self._points[4][1].sum())
         return float(np.sum(lam * normal[1]))
 
+    @property
+    def _length(self) -> float:
+        return self.radius
+
+    def _solved_contact(self, solved) -> tuple[float, bool]:
+        return self._contact_force(solved[8], solved[9]), bool(np.any(solved[2]))
+
+    def _pair_modulus(self) -> float:
+        return self.material.E / (1.0 - self.material.nu**2)  # rigid partner: E* = E'
+
+    def _residual_surface(self, u: np.ndarray) -> np.ndarray:
+        return self.X[:, self.surface] + self._nodal(u, self.surface)
+
     def _commit(self, run: _RunState, h_new: float, solved, branch: int) -> None:
         """Record a converged increment and make it the run's state."""
         hist = self._hist
@@ -605,19 +770,7 @@ class IndentationSolver:
         if self.segments is not None:  # where the gap of the points crosses zero
             a_ref = self.segments.contact_radius(self._points[0])
             a_sub = float(np.interp(a_ref, self.X[0, self.surface], xs[0]))
-        if branch == LOAD:
-            run.work += work_increment(run.h, h_new, run.F, F)
-            if len(hist.h) == 1 and run.F > 0 and F > run.F:
-                # the first increment assumed Hertz's exponent 3/2: use the one measured now
-                p = np.log(F / run.F) / np.log(h_new / run.h)
-                first = run.F * run.h / (p + 1.0)
-                run.work += first - hist.work_external[0]
-                hist.work_external[0] = first
-        elif hist.branch and hist.branch[-1] == branch and len(hist.h) >= 2:
-            # unloading and elastic reloading: the parabola through this and the last two points
-            run.work += quadratic_work(hist.h[-2], run.h, h_new, hist.F[-2], run.F, F)
-        else:  # first interval of a branch
-            run.work += 0.5 * (run.F + F) * dh
+        self._add_work(run, h_new, F, branch)
         run.h, run.F, run.a = h_new, F, a_ref
         run.h_top = max(run.h_top, h_new)
         hist.h.append(h_new)
@@ -642,114 +795,6 @@ class IndentationSolver:
         if self._progress is not None:
             self._progress(h_new)
         run.last_iterations = its
-
-    def _out_of_time(self, run: _RunState) -> bool:
-        if time.perf_counter() - run.t_start > self.options.max_wall_s:
-            run.status = "stopped"
-            run.reason = (f"wall-time limit of {self.options.max_wall_s:g} s reached at "
-                          f"h/R = {run.h / self.radius:.6g}")
-            return True
-        return False
-
-    def _cut_back(self, run: _RunState, dh: float, err) -> bool:
-        """False (and the run stopped) when the halved increment falls below dh_min."""
-        if 0.5 * dh < self.options.dh_min * self.radius:
-            run.status = "stopped"
-            run.reason = (f"increment below dh_min = {self.options.dh_min:g} R at "
-                          f"h/R = {run.h / self.radius:.6g}: {err}")
-            return False
-        return True
-
-    def _load_leg(self, run: _RunState, peak: float, targets=None) -> bool:
-        """Load (elastic reloading first, below the largest approach reached) up to ``peak``."""
-        opt, R = self.options, self.radius
-        while run.h < peak * (1 - 1e-12):
-            if self._out_of_time(run):
-                return False
-            if run.h < run.h_top * (1 - 1e-12):  # elastic reloading up to the previous maximum
-                dh, branch = min(run.dh_cycle, run.h_top - run.h), RELOAD
-            else:
-                a_last = self._hist.a_nodes[-1] if self._hist.a_nodes else 0.0
-                if targets is not None:
-                    ahead = targets[targets > run.h * (1 + 1e-12)]
-                    run.dh = min(run.dh, (ahead[0] if ahead.size else peak) - run.h)
-                else:
-                    run.dh = min(run.dh, peak - run.h, opt.dh_max * R,
-                                 max(opt.strain_increment * a_last, opt.dh_first * R))
-                dh, branch = run.dh, LOAD
-            solved = self._solve(run, run.h + dh)
-            if isinstance(solved, Exception):
-                if not self._cut_back(run, dh, solved):
-                    return False
-                if branch == RELOAD:
-                    run.dh_cycle *= 0.5
-                else:
-                    run.dh *= 0.5
-                continue
-            self._commit(run, run.h + dh, solved, branch)
-            if branch == LOAD:
-                if targets is not None:
-                    run.dh = np.inf
-                elif run.last_iterations <= opt.easy_iterations:
-                    run.dh *= opt.growth
-        return True
-
-    def _unload_leg(self, run: _RunState) -> dict | None:
-        """Unload from the current approach until the force vanishes; the cycle's summary.
-
-        Increments: about ``options.unload_increments`` over the elastic recovery estimated from
-        Sneddon's initial stiffness 2E*a, Δh ≈ 1.5 F_max/(2E*a). The last increment lands on
-        h_res, extrapolated from the last two points with F > 0 (:func:`residual_approach`).
-        """
-        hist, R = self._hist, self.radius
-        i_peak = len(hist.h) - 1
-        h_peak, F_peak, a_peak = run.h, run.F, run.a
-        E_star = self.material.E / (1.0 - self.material.nu**2)  # rigid partner
-        recovery = 1.5 * F_peak / (2.0 * E_star * a_peak) if a_peak > 0 else run.h
-        run.dh_cycle = max(min(recovery, run.h) / self.options.unload_increments, self.options.dh_min * R * 4)
-        run.u_prev = None
-        dh = run.dh_cycle
-        lost, h_lost = False, 0.0
-        while True:
-            if self._out_of_time(run):
-                return None
-            if not lost:
-                h_new = run.h - dh
-            elif len(hist.h) - i_peak >= 2:
-                h_new = min(max(residual_approach(np.array(hist.h[i_peak:]), np.array(hist.F[i_peak:])),
-                                h_lost), run.h)
-            else:
-                h_new = 0.5 * (run.h + h_lost)
-            if h_new <= 0.0:
-                h_new, lost = 0.0, True
-            solved = self._solve(run, h_new)
-            if isinstance(solved, Exception):
-                if not self._cut_back(run, dh, solved):
-                    return None
-                dh *= 0.5
-                continue
-            F_new = self._contact_force(solved[8], solved[9])
-            if lost or (F_new > 1e-9 * F_peak and np.any(solved[2])):
-                self._commit(run, h_new, solved, UNLOAD)
-                if lost or h_new == 0.0:
-                    break
-                continue
-            lost, h_lost = True, h_new  # contact lost between run.h and h_new: land on h_res next
-        base = run.cycle_base
-        i_end = len(hist.h) - 1
-        xs = self.X[:, self.surface] + self._nodal(run.u, self.surface)
-        cycle = {"h_max": h_peak, "F_max": F_peak, "a_max": hist.a[i_peak], "h_res": run.h,
-                 "pole_radius": pole_radius(xs[0], xs[1], 0.5 * hist.a[i_peak]),
-                 "work_in": hist.work_external[i_peak] - base["work"],
-                 "work_returned": hist.work_external[i_peak] - hist.work_external[i_end],
-                 "dissipation": hist.dissipation[i_end] - base["dissipation"],
-                 "elastic_energy_change": hist.energy_elastic[i_end] - base["energy_elastic"],
-                 "increment_start": base["increment"], "increment_peak": i_peak, "increment_end": i_end,
-                 "profile_r": xs[0].copy(), "profile_z": xs[1].copy()}
-        run.cycle_base = {"work": hist.work_external[i_end], "dissipation": hist.dissipation[i_end],
-                          "energy_elastic": hist.energy_elastic[i_end], "increment": i_end + 1}
-        run.u_prev = None
-        return cycle
 
     def _timer_split(self) -> dict:
         """Seconds spent per phase: constitutive update, assembly, contact, factorisation,
@@ -796,18 +841,7 @@ class IndentationSolver:
                 raise ValueError("schedule must be an increasing sequence of approaches > 0")
             targets = np.append(targets[targets < h_max * (1 - 1e-12)], h_max)
             run.dh = np.inf
-        peaks = list(unload)
-        if not peaks or peaks[-1] < h_max * (1 - 1e-12):
-            peaks.append(h_max)
-        cycles = []
-        for peak in peaks:
-            if not self._load_leg(run, peak, targets):
-                break
-            if unload.size and np.any(np.abs(unload - peak) <= 1e-12 * R):
-                cycle = self._unload_leg(run)
-                if cycle is None:
-                    break
-                cycles.append(cycle)
+        cycles = self._walk(run, h_max, unload, targets)
         status, reason = run.status, run.reason
         u, state = run.u, run.state
         wall = time.perf_counter() - run.t_start
