@@ -240,9 +240,6 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
     if progress is not None and not callable(progress):
         raise ValueError("progress must be a callable progress(h) or None")
     unload = check_unload_at(unload_at, h)
-    if unload.size and chosen == "two_body":
-        raise ValueError("unload_at: unloading cycles are available for one sphere on a rigid flat "
-                         "or rigid sphere and for the equal pair; not yet for two deformable bodies")
     return {"material": material, "radius": R, "h_max": h, "indenter_radius": R_ind,
             "density": d, "element": element, "options": options, "progress": progress,
             "material2": material2, "radius2": R2, "scene": chosen,
@@ -298,7 +295,7 @@ def run_indentation(material: Material, radius: float, h_max: float,
     converged increment. ``schedule`` (one-body scenes): the approaches to step to
     instead of adaptive increments (``IndentationSolver.run``). ``unload_at``: increasing
     approaches in (0, h_max] at which the pair is unloaded until the force vanishes and then
-    reloaded (one-body scenes; labels in ``curves["branch"]``, summaries in ``cycles``).
+    reloaded (labels in ``curves["branch"]``, summaries in ``cycles``).
     Returns the solver's ``RunResult``.
     """
     a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
@@ -310,7 +307,7 @@ def run_indentation(material: Material, radius: float, h_max: float,
             raise ValueError("schedule: prescribed increments exist for the one-body scenes only")
         solver = TwoBodySolver(a["material"], a["radius"], a["material2"], a["radius2"],
                                density=a["density"], element=a["element"], options=a["options"])
-        return solver.run(a["h_max"], progress=a["progress"])
+        return solver.run(a["h_max"], progress=a["progress"], unload_at=unload_at)
     h_run, progress = a["h_max"], a["progress"]
     if chosen == "equal_pair_symmetry":
         h_run = 0.5 * h_run

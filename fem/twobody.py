@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from types import SimpleNamespace
 from typing import NamedTuple
 
 import numpy as np
@@ -42,14 +43,17 @@ from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segments import N_COORDS, gap_gradient, gap_hessian
 from .solver import (
     ROUNDOFF,
+    CycleLegs,
     IncrementFailed,
     RunResult,
     SolverOptions,
+    _RunState,
+    check_unload_at,
+    cycles_as_arrays,
     finish_curves,
     new_active_log,
     plastic_dissipation,
     update_active_set,
-    work_increment,
 )
 
 #: |g| of active nodes at convergence, relative to the smaller radius
@@ -204,7 +208,7 @@ class ContactPass:
         return K if Kh is None else K + Kh
 
 
-class TwoBodySolver:
+class TwoBodySolver(CycleLegs):
     """Two elastic–plastic hemispheres on one axis; call ``run(h_max)`` (h = h₁ + h₂).
 
     Contact: exact (Lagrange multipliers, one pass: slave = the smaller sphere) by
@@ -462,93 +466,113 @@ class TwoBodySolver:
         coef = np.polyfit(xs[0][inner] ** 2, xs[1][inner], 1)
         return 2.0 * coef[0]
 
-    def run(self, h_max: float, progress=None) -> RunResult:
-        """Press the bodies together to the total approach ``h_max`` (h₁ + h₂)."""
+    def run(self, h_max: float, progress=None, unload_at=None) -> RunResult:
+        """Press the bodies together to the total approach ``h_max`` (h₁ + h₂).
+
+        ``unload_at``: increasing approaches in (0, h_max] at which the pair is unloaded until
+        the force vanishes and then reloaded (:class:`~.solver.CycleLegs`).
+        """
         R, opt = self.R, self.options
         h_max = float(h_max)
         if not (np.isfinite(h_max) and 0 < h_max <= 0.8 * R):
             raise ValueError(f"h_max must lie in (0, 0.8 min(R1, R2)] = (0, {0.8 * R:g}], got {h_max!r}")
-        t_start = time.perf_counter()
+        unload = check_unload_at(unload_at, h_max)
         for k in self.timers:
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(self.options.linear_solver)
         self.rejected = []
-        u = np.zeros(self.n_dofs)
-        u_prev = None
-        states = [PlasticState.virgin(b.disc.n_elements * b.disc.n_qp) for b in self.bodies]
-        active = np.zeros(self.candidates.size, dtype=bool)
-        lam = np.zeros(self.candidates.size)
-        rec = {k: [] for k in ("h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max",
-                               "work_external", "energy_elastic", "dissipation", "iterations",
-                               "active_changes", "h1", "h2", "interface_curvature", "dissipation_1",
-                               "dissipation_2", "eps_p_max_1", "eps_p_max_2")}
-        residuals, prof_r, prof_p, prof_g = [], [], [], []
-        h, dh, dh_prev = 0.0, opt.dh_first * R, None
-        status, reason = "converged", "reached h_max"
-        work, F_last = 0.0, 0.0
-        s = self.slave
-        while h < h_max * (1 - 1e-12):
-            if time.perf_counter() - t_start > opt.max_wall_s:
-                status = "stopped"
-                reason = f"wall-time limit of {opt.max_wall_s:g} s reached at h/R_min = {h / R:.6g}"
-                break
-            a_last = rec["a_nodes"][-1] if rec["a_nodes"] else 0.0
-            dh = min(dh, h_max - h, opt.dh_max * R, max(opt.strain_increment * a_last, opt.dh_first * R))
-            h_new = h + dh
-            u_pred = self._predictor(dh) if u_prev is None else u + (dh / dh_prev) * (u - u_prev)
-            u_pred = self._apply_bc(u_pred, h_new)
-            try:
-                newton = self._newton if self.k_penalty is None else self._newton_penalty
-                u_new, per_body, f, act, lam_new, gap, normal, its, log, F = newton(
-                    u_pred, states, active.copy(), lam.copy())
-            except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
-                self.rejected.append((h_new, dh, str(err)))
-                dh *= 0.5
-                if dh < opt.dh_min * R:
-                    status = "stopped"
-                    reason = f"increment below dh_min = {opt.dh_min:g} R_min at h/R_min = {h / R:.6g}: {err}"
-                    break
-                continue
-            # ---- commit
-            states = [PlasticState(upd.cp_inv, upd.eps_p, st.dissipation
-                                   + plastic_dissipation(b.disc, b.material, st.eps_p, upd.dgamma))
-                      for b, st, (_, upd, _) in zip(self.bodies, states, per_body, strict=True)]
-            diss = [st.dissipation for st in states]
-            u_prev, u, dh_prev, active, lam = u, u_new, dh, act, lam_new
-            h = h_new
-            b1, b2 = self.bodies
-            F_support = -float(f[b1.offset + 2 * b1.hmesh.equator + 1].sum())
-            xs = s.positions(u, self.candidates)
-            arc = s.hmesh.surface
-            areas = surface_areas(s.positions(u, arc))[:-1]
-            pressure = np.where(active, lam / areas, 0.0)
-            a_nodes, a_sub, a_ref = contact_edge(s.hmesh.X[0, self.candidates], xs[0], gap, active)
-            work += work_increment(h - dh, h, F_last, F)
-            F_last = F
-            h1, h2 = self._pole_shortening(u, h)
-            for key, val in (("h", h), ("F", F), ("F_support", F_support), ("a", a_sub),
-                             ("a_nodes", a_nodes), ("a_ref", a_ref),
-                             ("eps_p_max", max(float(st.eps_p.max()) for st in states)),
-                             ("work_external", work),
-                             ("energy_elastic", sum(b.disc.integrate(upd.psi) for b, (_, upd, _)
-                                                    in zip(self.bodies, per_body, strict=True))),
-                             ("dissipation", diss[0] + diss[1]), ("iterations", its),
-                             ("active_changes", log["changes"]), ("h1", h1), ("h2", h2),
-                             ("interface_curvature", self._interface_curvature(xs, a_sub)),
-                             ("dissipation_1", diss[0]), ("dissipation_2", diss[1]),
-                             ("eps_p_max_1", float(states[0].eps_p.max())),
-                             ("eps_p_max_2", float(states[1].eps_p.max()))):
-                rec[key].append(val)
-            residuals.append(log["res"])
-            prof_r.append(xs[0].copy())
-            prof_p.append(pressure)
-            prof_g.append(gap if self.k_penalty is not None else np.where(active, 0.0, gap))
-            if progress is not None:
-                progress(h)
-            if its <= opt.easy_iterations:
-                dh *= opt.growth
-        return self._result(rec, residuals, prof_r, prof_p, prof_g, status, reason, u, states,
-                            h_max, time.perf_counter() - t_start)
+        run = _RunState(t_start=time.perf_counter(), u=np.zeros(self.n_dofs),
+                        state=[PlasticState.virgin(b.disc.n_elements * b.disc.n_qp) for b in self.bodies],
+                        active=np.zeros(self.candidates.size, dtype=bool), dh=opt.dh_first * R)
+        run.lam = np.zeros(self.candidates.size)
+        self._rec = {k: [] for k in ("h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max",
+                                     "work_external", "energy_elastic", "dissipation", "iterations",
+                                     "active_changes", "h1", "h2", "interface_curvature", "dissipation_1",
+                                     "dissipation_2", "eps_p_max_1", "eps_p_max_2", "branch")}
+        self._hist = SimpleNamespace(**self._rec)  # the same lists, by attribute
+        self._profiles = ([], [], [], [])  # residuals, r, p, gap per increment
+        self._progress = progress
+        cycles = self._walk(run, h_max, unload)
+        residuals, prof_r, prof_p, prof_g = self._profiles
+        result = self._result(self._rec, residuals, prof_r, prof_p, prof_g, run.status, run.reason, run.u,
+                              run.state, h_max, time.perf_counter() - run.t_start)
+        result.cycles = cycles_as_arrays(cycles, self.candidates.size)
+        result.inputs["unload_at"] = [float(x) for x in unload]
+        return result
+
+    # ------------------------------------------------------------------ hooks of CycleLegs
+    @property
+    def _length(self) -> float:
+        return self.R
+
+    def _pair_modulus(self) -> float:
+        e1, e2 = (b.material.E_prime for b in self.bodies)
+        return 1.0 / (1.0 / e1 + 1.0 / e2)
+
+    def _solved_contact(self, solved) -> tuple[float, bool]:
+        return float(solved[9]), bool(np.any(solved[3]))
+
+    def _residual_surface(self, u: np.ndarray) -> np.ndarray:
+        """Deformed (r, z) of the slave's contact candidates."""
+        return self.slave.positions(u, self.candidates)
+
+    def _solve(self, run: _RunState, h_new: float):
+        """Newton for one increment to ``h_new``: the converged tuple, or the exception."""
+        dh = h_new - run.h
+        if run.u_prev is None:  # first increment, or the first after a reversal
+            u_pred = self._predictor(dh) if run.h == 0.0 else run.u.copy()
+        else:
+            u_pred = run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
+        u_pred = self._apply_bc(u_pred, h_new)
+        try:
+            newton = self._newton if self.k_penalty is None else self._newton_penalty
+            return newton(u_pred, run.state, run.active.copy(), run.lam.copy())
+        except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
+            self.rejected.append((h_new, dh, str(err)))
+            return err
+
+    def _commit(self, run: _RunState, h_new: float, solved, branch: int) -> None:
+        """Record a converged increment and make it the run's state."""
+        u_new, per_body, f, act, lam_new, gap, normal, its, log, F = solved
+        states = [PlasticState(upd.cp_inv, upd.eps_p, st.dissipation
+                               + plastic_dissipation(b.disc, b.material, st.eps_p, upd.dgamma))
+                  for b, st, (_, upd, _) in zip(self.bodies, run.state, per_body, strict=True)]
+        diss = [st.dissipation for st in states]
+        run.state = states
+        run.u_prev, run.u, run.dh_prev, run.active, run.lam = run.u, u_new, h_new - run.h, act, lam_new
+        s, u = self.slave, u_new
+        b1, b2 = self.bodies
+        F_support = -float(f[b1.offset + 2 * b1.hmesh.equator + 1].sum())
+        xs = s.positions(u, self.candidates)
+        areas = surface_areas(s.positions(u, s.hmesh.surface))[:-1]
+        pressure = np.where(act, lam_new / areas, 0.0)
+        a_nodes, a_sub, a_ref = contact_edge(s.hmesh.X[0, self.candidates], xs[0], gap, act)
+        self._add_work(run, h_new, F, branch)
+        run.h, run.F, run.a = h_new, F, a_ref
+        run.h_top = max(run.h_top, h_new)
+        h1, h2 = self._pole_shortening(u, h_new)
+        rec = self._rec
+        for key, val in (("h", h_new), ("F", F), ("F_support", F_support), ("a", a_sub),
+                         ("a_nodes", a_nodes), ("a_ref", a_ref),
+                         ("eps_p_max", max(float(st.eps_p.max()) for st in states)),
+                         ("work_external", run.work),
+                         ("energy_elastic", sum(b.disc.integrate(upd.psi) for b, (_, upd, _)
+                                                in zip(self.bodies, per_body, strict=True))),
+                         ("dissipation", diss[0] + diss[1]), ("iterations", its),
+                         ("active_changes", log["changes"]), ("h1", h1), ("h2", h2),
+                         ("interface_curvature", self._interface_curvature(xs, a_sub)),
+                         ("dissipation_1", diss[0]), ("dissipation_2", diss[1]),
+                         ("eps_p_max_1", float(states[0].eps_p.max())),
+                         ("eps_p_max_2", float(states[1].eps_p.max())), ("branch", branch)):
+            rec[key].append(val)
+        residuals, prof_r, prof_p, prof_g = self._profiles
+        residuals.append(log["res"])
+        prof_r.append(xs[0].copy())
+        prof_p.append(pressure)
+        prof_g.append(gap if self.k_penalty is not None else np.where(act, 0.0, gap))
+        if self._progress is not None:
+            self._progress(h_new)
+        run.last_iterations = its
 
     def _result(self, rec, residuals, prof_r, prof_p, prof_g, status, reason, u, states, h_max, wall):
         curves = finish_curves({k: np.asarray(v, dtype=float) for k, v in rec.items()})

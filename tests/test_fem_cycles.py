@@ -93,14 +93,32 @@ def test_cycles_survive_the_run_file(plastic_run, tmp_path):
     assert back.cycles["profile_z"].shape == (2, back.profile_r.shape[1])
 
 
-def test_equal_pair_doubles_the_approaches_and_two_bodies_are_refused():
+def test_equal_pair_doubles_the_approaches():
     res = run_indentation(EPP, 1.0, 0.012, radius2=1.0, material2=EPP, density=0.5, unload_at=[0.012])
     assert res.inputs["scene"] == "equal_pair_symmetry"
     assert res.cycles["h_max"][0] == pytest.approx(0.012)
     assert 0.3 < res.cycles["h_res"][0] / 0.012 < 0.95
-    with pytest.raises(ValueError, match="two deformable bodies"):
-        run_indentation(EPP, 1.0, 0.01, radius2=2.0, material2=Material(E=600.0, nu=0.3, sigma_y=1.0),
-                        unload_at=[0.01])
+
+
+def test_two_deformable_bodies_unload_and_reload():
+    """Elastic pair E₂/E₁ = 3: no dent, the split h₁/h stays E₂'/(E₁' + E₂') on unloading;
+    a plastic pair of yield ratio 3 leaves a dent, mostly in the softer body."""
+    stiff = Material(E=600.0, nu=0.3, sigma_y=math.inf)
+    el = run_indentation(ELASTIC, 1.0, 0.004, radius2=1.0, material2=stiff, density=0.5, unload_at=[0.004],
+                         scene="two_body")
+    c, cyc = el.curves, el.cycles
+    assert el.inputs["scene"] == "two_body" and el.status == "converged"
+    assert cyc["h_res"][0] / cyc["h_max"][0] < 0.03
+    unl = (c["branch"] == UNLOAD) & (c["F"] > 0.2 * cyc["F_max"][0])
+    assert np.allclose(c["h1"][unl] / c["h"][unl], 0.75, atol=0.02)
+    hard = Material(E=200.0, nu=0.3, sigma_y=3.0)
+    pl = run_indentation(EPP, 1.0, 0.01, radius2=1.0, material2=hard, density=0.5, unload_at=[0.01],
+                         scene="two_body")
+    assert 0.3 < pl.cycles["h_res"][0] / 0.01 < 0.95
+    assert pl.curves["dissipation_1"][-1] > 10 * pl.curves["dissipation_2"][-1]
+    balance = pl.cycles["work_in"] - pl.cycles["work_returned"]
+    assert balance[0] == pytest.approx(pl.cycles["dissipation"][0] + pl.cycles["elastic_energy_change"][0],
+                                       rel=0.03)
 
 
 def test_cli_rejects_a_bad_schedule_before_any_work(tmp_path, capsys):
