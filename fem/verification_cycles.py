@@ -13,6 +13,9 @@ Runs (``--out`` gets ``cycles.md``, ``cycles_verification.json``, ``cycles.png``
 * EPP E/σY = 200 monotone (cost of a cycle; the curve the reloads must rejoin);
 * EPP E/σY = 200 to h/R = 0.1 on a 2× mesh and with half increments (loading strain
   increment and unloading increments): h_res and the unloading curves within 1 %;
+* two deformable bodies (exact contact): an elastic pair E₂ = 3E₁ (no dent, the split
+  h₁/h = E₂'/(E₁' + E₂') along the unloading) and a plastic pair of yield ratio 3 (each
+  body's share of the residual approach);
 * Thornton (1997, J. Appl. Mech. 64:383): Hertzian unloading with the residual radius
   R_p = 4E*a_max³/(3F_max), h_res = h_max − (3F_max/(4E*√R_p))^{2/3},
   F = (4/3)E*√R_p (h − h_res)^{3/2}: a sanity check beside the FE, not a reference.
@@ -32,6 +35,7 @@ import numpy as np
 
 from ..model.material import Material
 from ..validation.metrics import scatter
+from .io import run_indentation
 from .solver import LOAD, RELOAD, UNLOAD, IndentationSolver, SolverOptions
 
 NU = 0.3
@@ -44,6 +48,11 @@ RUNS = {
     "E200_monotone": (200.0, 0.3, None, 1.0, 0.005, 24),
     "E200_mesh2": (200.0, 0.1, CYCLES_AT[:3], 2.0, 0.005, 24),
     "E200_half_increment": (200.0, 0.1, CYCLES_AT[:3], 1.0, 0.0025, 48),
+}
+#: two deformable bodies (exact contact): name → (body 2 (E/σY₁, σY₂/σY₁; inf: elastic), h_max, unload_at)
+PAIR_RUNS = {
+    "pair_elastic_E3": ((600.0, math.inf), 0.01, (0.001, 0.01)),
+    "pair_yield3": ((200.0, 3.0), 0.03, (0.01, 0.03)),
 }
 LIMITS = {"elastic_retrace": 0.001, "energy": 0.01, "convergence": 0.01, "sneddon_small": 0.02,
           "cycle_cost": 0.20}
@@ -63,6 +72,43 @@ def run_case(name: str) -> dict:
             "curves": {k: np.asarray(res.curves[k]).tolist() for k in keep},
             "cycles": {k: np.asarray(v).tolist() for k, v in res.cycles.items()
                        if not k.startswith("profile")}}
+
+
+def run_pair_case(name: str) -> dict:
+    """One two-body run of :data:`PAIR_RUNS` (body 1: EPP E/σY 200, or elastic for the elastic pair)."""
+    (E2, sy2), h_max, unload = PAIR_RUNS[name]
+    elastic = math.isinf(sy2)
+    m1 = Material(E=200.0, nu=NU, sigma_y=math.inf if elastic else 1.0)
+    m2 = Material(E=E2, nu=NU, sigma_y=sy2)
+    res = run_indentation(m1, 1.0, h_max, radius2=1.0, material2=m2, scene="two_body", unload_at=list(unload))
+    keep = ("h", "F", "a", "h1", "h2", "branch", "dissipation_1", "dissipation_2")
+    return {"name": name, "E": 200.0, "E2": E2, "status": res.status, "wall_s": res.timings["wall_s"],
+            "increments": res.timings["increments"], "n_dofs": res.inputs["n_dofs"],
+            "curves": {k: np.asarray(res.curves[k]).tolist() for k in keep},
+            "cycles": {k: np.asarray(v).tolist() for k, v in res.cycles.items()
+                       if not k.startswith("profile")}}
+
+
+def analyse_pairs(runs: dict) -> list[dict]:
+    """Per cycle of the two-body runs: h_res/h_max, each body's share of the residual approach,
+    the elastic split h₁/h on unloading against E₂'/(E₁' + E₂'), energy per cycle."""
+    out = []
+    for name in PAIR_RUNS:
+        if name not in runs:
+            continue
+        c, cyc = _arrays(runs[name]), runs[name]["cycles"]
+        for i, hm in enumerate(cyc["h_max"]):
+            _, unl = _branch(c, cyc, i)
+            ie = unl[-1]
+            row = {"run": name, "h_max": hm, "h_res_over_h_max": cyc["h_res"][i] / hm,
+                   "h1_share_of_h_res": float(c["h1"][ie] / c["h"][ie]) if c["h"][ie] > 0 else math.nan,
+                   "energy_error": abs(cyc["work_in"][i] - cyc["work_returned"][i] - cyc["dissipation"][i]
+                                       - cyc["elastic_energy_change"][i]) / cyc["work_in"][i]}
+            if name == "pair_elastic_E3":
+                sel = unl[c["F"][unl] > 0.2 * cyc["F_max"][i]]
+                row["split_on_unloading_max_dev"] = float(np.max(np.abs(c["h1"][sel] / c["h"][sel] - 0.75)))
+            out.append(row)
+    return out
 
 
 def _arrays(run: dict) -> dict:
@@ -273,6 +319,15 @@ def report(res: dict) -> str:
               "| run | h_max/R | h_res/h_max FE | Thornton | unloading F max |ΔF|/F_max % |", "|---|---|---|---|---|"]
     lines += [f"| {t['run']} | {t['h_max']:g} | {t['h_res_over_h_max_fe']:.3f} | {t['h_res_over_h_max_thornton']:.3f}"
               f" | {_pct(t['F_max_dev_over_F_max'])} |" for t in res["thornton"]]
+    lines += ["", "## Two deformable bodies (exact contact, equal radii; body 1 EPP E/σY 200, elastic for the elastic pair)", "",
+              "pair_elastic_E3: body 2 elastic with E₂ = 3E₁ (h₁/h = E₂'/(E₁' + E₂') = 0.75); pair_yield3: body 2 "
+              "with σY₂ = 3σY₁. h₁ share: body 1's part of the residual approach.", "",
+              "| run | h_max/R | h_res/h_max | h₁/h at h_res | energy error % | split on unloading, max dev from 0.75 |",
+              "|---|---|---|---|---|---|"]
+    for p in res.get("pairs", []):
+        split = f"{p['split_on_unloading_max_dev']:.4f}" if "split_on_unloading_max_dev" in p else "—"
+        lines.append(f"| {p['run']} | {p['h_max']:g} | {p['h_res_over_h_max']:.4f} | {p['h1_share_of_h_res']:.3f} | "
+                     f"{_pct(p['energy_error'])} | {split} |")
     c = res["cost"]
     lines += ["", "## Cost", "", f"E/σY = 200 to h/R = 0.3: {c['wall_monotone_s']:.0f} s monotone, "
               f"{c['wall_with_4_cycles_s']:.0f} s with 4 cycles: {_pct(c['added_per_cycle'])} % per cycle.", "",
@@ -289,14 +344,18 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     names = sorted(RUNS, key=lambda n: -RUNS[n][3] * RUNS[n][1])  # longest first
-    cache = out / ".cycles_runs.json"  # the raw runs, to redo the analysis with --reuse
-    if args.reuse and cache.exists():
-        runs = json.loads(cache.read_text())
-    else:
-        with ProcessPoolExecutor(args.workers) as pool:
-            runs = dict(zip(names, pool.map(run_case, names), strict=True))
-        cache.write_text(json.dumps(runs))
+    cache = out / ".cycles_runs.json"  # the raw runs: --reuse runs only those missing
+    runs = json.loads(cache.read_text()) if args.reuse and cache.exists() else {}
+    todo = [n for n in names if n not in runs]
+    pairs = [n for n in PAIR_RUNS if n not in runs]
+    with ProcessPoolExecutor(args.workers) as pool:
+        runs.update(zip(pairs, pool.map(run_pair_case, pairs), strict=True))
+        runs.update(zip(todo, pool.map(run_case, todo), strict=True))
+    cache.write_text(json.dumps(runs))
     res = analyse(runs)
+    res["pairs"] = analyse_pairs(runs)
+    res["runs"].update({n: {k: runs[n][k] for k in ("status", "wall_s", "increments", "n_dofs")}
+                        for n in PAIR_RUNS if n in runs})
     (out / "cycles_verification.json").write_text(json.dumps(res, indent=1) + "\n")
     chart(runs, out / "cycles.png")
     (out / "cycles.md").write_text(report(res))
