@@ -13,6 +13,8 @@ fixed CSR pattern (about 10× faster than form assembly, see notes).
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import scipy.sparse as sp
 import skfem
@@ -77,10 +79,13 @@ class Discretisation:
         self._indptr = np.concatenate([[0], np.cumsum(np.bincount(r, minlength=nd))]).astype(np.int32)
         self._keys = uniq
         self._rows, self._cols = r, c
-        # for every stored entry (i, j): the slots of the four entries of its node pair's 2×2 block
-        I, J = r // 2, c // 2
-        sib = np.stack([((2 * I + a) * nd + 2 * J + b) for a in range(2) for b in range(2)], axis=-1)
-        self._siblings = self.slots(sib // nd, sib % nd).reshape(-1, 2, 2)
+
+    @functools.cached_property
+    def _siblings(self) -> np.ndarray:
+        """For every stored entry (i, j): the slots of the four entries of its node pair's 2×2
+        block (built on first use: only curved obstacles rotate blocks)."""
+        I, J = self._rows // 2, self._cols // 2
+        return self.node_block_slots(I, J)
 
     @property
     def n_entries(self) -> int:
@@ -97,18 +102,20 @@ class Discretisation:
 
     def node_block_slots(self, nodes_i: np.ndarray, nodes_j: np.ndarray) -> np.ndarray:
         """(n, 2, 2) data positions of the 2×2 blocks coupling nodes_i[k] with nodes_j[k]."""
-        ni = np.asarray(nodes_i)[:, None, None]
-        nj = np.asarray(nodes_j)[:, None, None]
-        a = np.arange(2)[None, :, None]
-        b = np.arange(2)[None, None, :]
-        return self.slots(2 * ni + a + 0 * b, 2 * nj + b + 0 * a)
+        rows = 2 * np.asarray(nodes_i)[:, None, None] + np.arange(2)[None, :, None]
+        cols = 2 * np.asarray(nodes_j)[:, None, None] + np.arange(2)[None, None, :]
+        return self.slots(*np.broadcast_arrays(rows, cols))
 
-    def rotate_blocks(self, data: np.ndarray, Q: np.ndarray, rotated: np.ndarray) -> np.ndarray:
-        """Tangent data in nodal frames: K̃_IJ = Q_Iᵀ K_IJ Q_J for nodes with ``rotated[I]``.
-
-        ``Q``: (n_nodes, 2, 2) frames (identity elsewhere). The pattern is unchanged, so
-        the rotated matrix keeps the factorisation's symbolic analysis.
+    def rotate_blocks(self, data: np.ndarray, nodes: np.ndarray, frames: np.ndarray) -> np.ndarray:
+        """Tangent data in nodal frames: K̃_IJ = Q_Iᵀ K_IJ Q_J, Q = ``frames[k]`` (2×2) at
+        ``nodes[k]`` and the identity elsewhere. The pattern is unchanged, so the rotated
+        matrix keeps the factorisation's symbolic analysis.
         """
+        n_nodes = self.n_dofs // 2
+        Q = np.broadcast_to(np.eye(2), (n_nodes, 2, 2)).copy()
+        Q[nodes] = frames
+        rotated = np.zeros(n_nodes, dtype=bool)
+        rotated[nodes] = True
         r, c = self._rows, self._cols
         I, J = r // 2, c // 2
         k = np.flatnonzero(rotated[I] | rotated[J])

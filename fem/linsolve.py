@@ -79,24 +79,25 @@ class SymmetricSolver:
             return
         n = upper.shape[0]
         cols = np.repeat(np.arange(n, dtype=np.int64), np.diff(upper.indptr))
-        keys = cols * n + upper.indices
+        own = cols * n + upper.indices
+        keys = own
         if self._solver is not None and self._keys is not None and n == self._n:
-            pos = np.searchsorted(self._keys, keys)
+            pos = np.searchsorted(self._keys, own)
             inside = pos < self._keys.size
-            inside[inside] = self._keys[pos[inside]] == keys[inside]
+            inside[inside] = self._keys[pos[inside]] == own[inside]
             if inside.all():
                 data = np.zeros(self._keys.size)
                 data[pos] = upper.data
                 self._solver.update(self._matrix(data), upper=True)
                 self.stats["ldl_update"] += 1
                 return
-            keys = np.union1d(self._keys, keys)
+            keys = np.union1d(self._keys, own)
         self._keys = np.asarray(keys, dtype=np.int64)
         self._n = n
         cols_u, self._rows = np.divmod(self._keys, n)
         self._indptr = np.concatenate([[0], np.cumsum(np.bincount(cols_u, minlength=n))])
         data = np.zeros(self._keys.size)
-        data[np.searchsorted(self._keys, cols * n + upper.indices)] = upper.data
+        data[np.searchsorted(self._keys, own)] = upper.data
         full = self._matrix(data)
         self._solver = qdldl.Solver(full, upper=True)
         self._pattern = _pattern_of(full)

@@ -31,7 +31,6 @@ from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segment_penalty import SegmentPenalty
 
-CLOSE_FULL_STEP = True
 #: nodal-force roundoff of the stress update, in units of E R² (see ``_newton``)
 ROUNDOFF = 1e-16
 
@@ -492,7 +491,6 @@ class IndentationSolver(CycleLegs):
         self.n_points = self.disc.n_elements * self.disc.n_qp
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "contact": 0.0, "linear": 0.0,
                        "line_search": 0.0}
-        self.linear = SymmetricSolver(self.options.linear_solver)
         self._diag_slots = self.disc.slots(np.arange(nd), np.arange(nd))
         self._nd = nd
         self.k_penalty = None
@@ -589,11 +587,7 @@ class IndentationSolver(CycleLegs):
             blocks = -(lam[idx] * curv[idx])[:, None, None] * np.einsum("ik,jk->kij", tt, tt)
             data = data.copy()
             np.add.at(data, self.disc.node_block_slots(nodes, nodes), blocks)
-            Q = np.broadcast_to(np.eye(2), (self.hmesh.n_nodes, 2, 2)).copy()
-            Q[frames[0]] = frames[1]
-            rotated = np.zeros(self.hmesh.n_nodes, dtype=bool)
-            rotated[frames[0]] = True
-            data = self.disc.rotate_blocks(data, Q, rotated)
+            data = self.disc.rotate_blocks(data, *frames)
         r = self._rotate(f, frames)
         du_c = np.zeros(self._nd)
         du_c[cdofs] = -gap[active] if self.obstacle.is_flat else np.concatenate(
@@ -697,7 +691,7 @@ class IndentationSolver(CycleLegs):
             s_a = float(np.dot(duf, r[free]))
             if abs(s_a) <= 0.5 * abs(s0):
                 return trial, known
-            if alpha == 1.0 and CLOSE_FULL_STEP and prescribed:
+            if alpha == 1.0 and prescribed:
                 return trial, known  # the step puts penetrating nodes back on the obstacle
             if s_a < 0.0:  # still descending: the zero lies beyond α
                 return trial, known

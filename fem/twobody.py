@@ -256,7 +256,6 @@ class TwoBodySolver(CycleLegs):
         self.free = np.ones(self.n_dofs, dtype=bool)
         self.free[self.fixed] = False
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
-        self.linear = SymmetricSolver(self.options.linear_solver)
 
     # ------------------------------------------------------------------ bodies
     def _stress(self, u, states, known=None):

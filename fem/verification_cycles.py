@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model.material import Material
-from ..validation.metrics import scatter
+from ..validation.metrics import interp_loglog, scatter
 from .io import run_indentation
 from .solver import LOAD, RELOAD, UNLOAD, IndentationSolver, SolverOptions
 
@@ -122,9 +122,9 @@ def _branch(c: dict, cyc: dict, i: int):
 
 
 def _loglog_interp(x, xp, yp):
-    """Interpolation of y(x) linear in ln x, ln y (exact for power laws)."""
+    """:func:`~..validation.metrics.interp_loglog` for points given in any order."""
     order = np.argsort(xp)
-    return np.exp(np.interp(np.log(x), np.log(xp[order]), np.log(yp[order])))
+    return interp_loglog(x, xp[order], yp[order])
 
 
 def unloading_stiffness(h: np.ndarray, F: np.ndarray) -> float:
