@@ -8,7 +8,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
 .PHONY: test bench lint verify-fem verify-pair verify-cycles verify-smoothness demo clean
-.PHONY: fem
+.PHONY: fem fem-v1 campaign-design
 .PHONY: validate
 .PHONY: calibrate
 .PHONY: peers-mdr
@@ -26,8 +26,17 @@ test: $(STAMP)
 demo: $(STAMP)
 	$(PY) -m spherecontact.demo --out reports/demo
 
+# campaign v2 (data/campaign_v2.toml) into data/reference_v2.h5; calibrate and validate read
+# data/reference.h5 (campaign v1) until v2 is complete
 fem: $(STAMP)
+	$(PY) -m spherecontact.fem.campaign --campaign data/campaign_v2.toml --db data/reference_v2.h5
+	$(PY) -m spherecontact.fem.design_report --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
+
+fem-v1: $(STAMP)
 	$(PY) -m spherecontact.fem.campaign --campaign data/campaign.toml --db data/reference.h5
+
+campaign-design: $(STAMP)
+	$(PY) -m spherecontact.fem.design_report --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
 
 calibrate: $(STAMP)
 	$(PY) -m spherecontact.calibration --db data/reference.h5 --out data/coefficients.json --report reports/calibration

@@ -29,10 +29,13 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
+import numpy as np
+from scipy.stats import qmc
+
 from ..data import input_key
 from ..model.material import Material
 from .assembly import ELEMENTS
-from .mesh import DENSITY_RANGE
+from .mesh import DENSITY_RANGE, EDGE_BAND_MAX
 from .solver import SolverOptions
 
 __all__ = ["PARAMETERS", "SCENES", "Param", "Case", "Campaign", "load_campaign", "parse_campaign"]
@@ -92,9 +95,17 @@ PARAMETERS = {
                             lo=0, hi=1e4, lo_open=False, default=0.0),
     "n": Param("Ludwik hardening exponent of body 1 (ignored, stored as 1, when K = 0)", lo=0, hi=1,
                default=1.0),
-    "h_max": Param("final approach in units of R1 (two_body: of min(R1, R2))", lo=0, hi=0.8),
+    "h_max": Param("final approach in units of the smaller radius, min(R1, R2) (R2: the rigid "
+                   "sphere's or body 2's radius; R1 on a flat)", lo=0, hi=0.8),
     "mesh_density": Param("mesh-density factor of the FE mesh", lo=DENSITY_RANGE[0], hi=DENSITY_RANGE[1],
                           lo_open=False, default=1.0),
+    "edge_band": Param("surface element size per unit distance from the pole (0: default mesh)",
+                       lo=0, hi=EDGE_BAND_MAX, lo_open=False, default=0.0),
+    "Q_over_sigma_y": Param("Voce saturation of body 1 over σY1: σ_f = σY + K ε_p^n + Q(1 − e^(−b ε_p))",
+                            lo=0, hi=1e4, lo_open=False, default=0.0),
+    "b": Param("Voce saturation rate of body 1 (ignored when Q = 0)", lo=0, hi=1e5, default=1.0),
+    "flow_curve": Param("name of a tabulated flow curve of body 1 in [flow_curves.<name>] "
+                        "(replaces K, n, Q, b)", choices=None, default=""),
     "element": Param("finite element", choices=tuple(sorted(ELEMENTS)), default="q8r"),
     "max_wall_s": Param("wall-time limit of one run in seconds (the run is stored as stopped)",
                         lo=0, default=math.inf),
@@ -118,8 +129,14 @@ _FROM_BODY1 = {"nu2": "nu", "K2_over_sigma_y1": "K_over_sigma_y", "n2": "n"}
 #: solver options a campaign may set in an ``options`` table (max_wall_s has its own key)
 OPTION_NAMES = tuple(f.name for f in fields(SolverOptions) if f.name != "max_wall_s")
 #: keys of an entry besides PARAMETERS
-_ENTRY_KEYS = ("options",)
-_SETS_RESERVED = ("campaign", "defaults")
+_ENTRY_KEYS = ("options", "cycles", "sample")
+_SETS_RESERVED = ("campaign", "defaults", "flow_curves")
+#: strain points of the table a Voce-type curve is stored as (linear between them)
+VOCE_STRAINS = (0.0, *np.geomspace(1e-5, 4.0, 90))
+#: space-filling designs of a ``sample`` table (scipy.stats.qmc)
+SAMPLERS = ("sobol", "lhs")
+#: significant digits of a sampled parameter value (readable names, stable keys)
+SAMPLE_DIGITS = 3
 
 
 # ============================================================================ cases
@@ -153,7 +170,8 @@ class Case:
         i = self.inputs
         kw = {"material": _material(i["material"]), "radius": i["radius"], "h_max": i["h_max"],
               "density": i["mesh_density"], "element": i["element"],
-              "options": SolverOptions(**i["options"], max_wall_s=self.max_wall_s)}
+              "options": SolverOptions(**i["options"], max_wall_s=self.max_wall_s),
+              "edge_band": i.get("edge_band", 0.0), "unload_at": i.get("unload_at")}
         if self.scene == "two_body":
             kw.update(radius2=i["radius2"], material2=_material(i["material2"]))
         else:
@@ -162,6 +180,8 @@ class Case:
 
 
 def _material(d: dict) -> Material:
+    if "eps_table" in d:
+        return Material.from_table(d["E"], d["nu"], d["eps_table"], d["sigma_table"])
     return Material(E=d["E"], nu=d["nu"], sigma_y=d["sigma_y"], K=d["K"], n=d["n"])
 
 
@@ -190,11 +210,22 @@ def _hardening(K: float, n: float) -> str:
     return "pp" if K == 0 else f"K{_fmt(K)}-n{_fmt(n)}"
 
 
+def _hardening1(p: dict) -> str:
+    """Body 1's flow-curve tag: a named table, Ludwik, Voce or both."""
+    if p.get("flow_curve"):
+        return p["flow_curve"]
+    tag = _hardening(p["K_over_sigma_y"], p["n"])
+    if p.get("Q_over_sigma_y", 0.0) > 0:
+        voce = f"voceQ{_fmt(p['Q_over_sigma_y'])}-b{_fmt(p['b'])}"
+        tag = voce if tag == "pp" else f"{tag}-{voce}"
+    return tag
+
+
 def _name(p: dict, defaults: dict) -> str:
     """Readable case name from the resolved parameters."""
     scene = {"flat": "flat", "rigid_sphere": f"rsphere{_fmt(p.get('indenter_radius', 0))}",
              "two_body": "two"}[p["scene"]]
-    parts = [scene, _hardening(p["K_over_sigma_y"], p["n"]), f"E{_fmt(p['E_over_sigma_y'])}",
+    parts = [scene, _hardening1(p), f"E{_fmt(p['E_over_sigma_y'])}",
              f"nu{_fmt(p['nu'])}"]
     if p["scene"] == "two_body":
         other = []
@@ -209,7 +240,7 @@ def _name(p: dict, defaults: dict) -> str:
         if (p["K2_over_sigma_y1"], p["n2"]) != (p["K_over_sigma_y"], p["n"]):
             other.append(_hardening(p["K2_over_sigma_y1"], p["n2"]))
         parts += ["vs", *(other or ["same"])]
-    for key, tag in (("h_max", "h"), ("mesh_density", "d")):
+    for key, tag in (("h_max", "h"), ("mesh_density", "d"), ("edge_band", "c")):
         if p[key] != defaults.get(key, PARAMETERS[key].default):
             parts.append(f"{tag}{_fmt(p[key])}")
     if p["element"] != defaults.get("element", PARAMETERS["element"].default):
@@ -240,8 +271,44 @@ def _check_keys(table: dict, where: str) -> None:
                          f"{', '.join([*PARAMETERS, *_ENTRY_KEYS])}")
 
 
-def _resolve(raw: dict, defaults: dict, where: str) -> tuple[dict, dict]:
+def _check_curves(doc: dict) -> dict:
+    """The ``[flow_curves.<name>]`` tables: eps_p from 0 increasing, sigma_over_sigma_y from 1
+    non-decreasing, and a source. Returns {name: (eps_p, sigma_over_sigma_y)}."""
+    curves = doc.get("flow_curves", {})
+    if not isinstance(curves, dict):
+        raise ValueError("[flow_curves] must hold tables [flow_curves.<name>]")
+    out = {}
+    for name, table in curves.items():
+        where = f"[flow_curves.{name}]"
+        if not isinstance(table, dict) or not {"eps_p", "sigma_over_sigma_y", "source"} <= set(table):
+            raise ValueError(f"{where} needs eps_p, sigma_over_sigma_y (lists) and source (text)")
+        eps, sig = table["eps_p"], table["sigma_over_sigma_y"]
+        try:
+            Material.from_table(1.0, 0.3, eps, sig)
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"{where}: {err}") from None
+        if sig[0] != 1:
+            raise ValueError(f"{where}: sigma_over_sigma_y must start at 1 (σ/σY at ε_p = 0), "
+                             f"got {sig[0]!r}")
+        out[name] = (tuple(float(x) for x in eps), tuple(float(x) for x in sig))
+    return out
+
+
+def _check_cycles(value, where: str) -> tuple:
+    """``cycles``: increasing approaches in (0, 1], in the unit of h_max."""
+    if not isinstance(value, list) or not value or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) for v in value):
+        raise ValueError(f"{where}: cycles must be a non-empty list of approaches, got {value!r}")
+    x = [float(v) for v in value]
+    if any(not 0 < v <= 0.8 for v in x) or any(b <= a for a, b in zip(x, x[1:], strict=False)):
+        raise ValueError(f"{where}: cycles must increase and lie in (0, 0.8] (units of h_max's "
+                         f"length), got {value!r}")
+    return tuple(x)
+
+
+def _resolve(raw: dict, defaults: dict, where: str, curves: dict | None = None) -> tuple[dict, dict]:
     """One grid point (entry over defaults) → (checked parameters, options)."""
+    curves = curves or {}
     scene = PARAMETERS["scene"].check("scene", raw.get("scene", defaults.get("scene")), where)
     for name in raw:
         if name in PARAMETERS and scene not in PARAMETERS[name].scenes:
@@ -254,10 +321,21 @@ def _resolve(raw: dict, defaults: dict, where: str) -> tuple[dict, dict]:
         value = raw.get(name, defaults.get(name, spec.default))
         if value is None and name in _FROM_BODY1:
             value = p[_FROM_BODY1[name]]
+        if name == "flow_curve":
+            if value and value not in curves:
+                raise ValueError(f"{where}: flow_curve = {value!r} is not a table of [flow_curves]; "
+                                 f"known: {', '.join(curves) or 'none'}")
+            p[name] = value
+            continue
         if value is None:
             raise ValueError(f"{where}: parameter {name} is required ({spec.doc}; range "
                              f"{spec.range_text()})")
         p[name] = spec.check(name, value, where)
+    if p["flow_curve"] and (p["K_over_sigma_y"] or p["Q_over_sigma_y"]):
+        raise ValueError(f"{where}: flow_curve {p['flow_curve']!r} replaces K_over_sigma_y and "
+                         "Q_over_sigma_y: leave those at 0")
+    if p["Q_over_sigma_y"] == 0:
+        p["b"] = 1.0  # no saturation term: b has no effect
     if p["K_over_sigma_y"] == 0:
         p["n"] = 1.0  # perfectly plastic: n has no effect
     if scene == "two_body" and p["K2_over_sigma_y1"] == 0:
@@ -267,14 +345,32 @@ def _resolve(raw: dict, defaults: dict, where: str) -> tuple[dict, dict]:
         raise ValueError(f"{where}: body 2 hardens (K2_over_sigma_y1 = {p['K2_over_sigma_y1']:g}) "
                          "but body 1 is perfectly plastic: give n2")
     options = {**defaults.get("options", {}), **raw.get("options", {})}
+    cycles = raw.get("cycles", defaults.get("cycles"))
+    p["cycles"] = _check_cycles(cycles, where) if cycles is not None else ()
     return p, _check_options(options, where)
 
 
-def _inputs(p: dict, options: dict) -> dict:
-    """Dimensional inputs of the FE run (what the key hashes)."""
+def _body1(p: dict, curves: dict) -> Material:
+    """Body 1's material: a named table, Ludwik, or Ludwik plus Voce saturation (tabulated)."""
+    sy = p["sigma_y"]
+    E = p["E_over_sigma_y"] * sy
+    if p.get("flow_curve"):
+        eps, sig = curves[p["flow_curve"]]
+        return Material.from_table(E, p["nu"], eps, [s * sy for s in sig])
+    lud = Material(E=E, nu=p["nu"], sigma_y=sy, K=p["K_over_sigma_y"] * sy, n=p["n"])
+    if p.get("Q_over_sigma_y", 0.0) == 0:
+        return lud
+    eps = np.array(VOCE_STRAINS)
+    sig = lud.flow_stress(eps) + p["Q_over_sigma_y"] * sy * -np.expm1(-p["b"] * eps)
+    return Material.from_table(E, p["nu"], eps, sig)
+
+
+def _inputs(p: dict, options: dict, curves: dict | None = None) -> dict:
+    """Dimensional inputs of the FE run (what the key hashes). The keys a default run leaves
+    out (edge_band 0, no cycles) are left out, so older runs keep their keys."""
     R, sy = p["radius"], p["sigma_y"]
     E = p["E_over_sigma_y"] * sy
-    mat = Material(E=E, nu=p["nu"], sigma_y=sy, K=p["K_over_sigma_y"] * sy, n=p["n"]).describe()
+    mat = _body1(p, curves or {}).describe()
     inputs = {"material": mat, "radius": R, "mesh_density": p["mesh_density"],
               "element": p["element"], "options": dict(options)}
     if p["scene"] == "two_body":
@@ -283,16 +379,71 @@ def _inputs(p: dict, options: dict) -> dict:
             E=p["E2_over_E1"] * E, nu=p["nu2"], sigma_y=p["sigma_y2_over_sigma_y1"] * sy,
             K=p["K2_over_sigma_y1"] * sy, n=p["n2"]).describe())
     else:
-        inputs.update(h_max=p["h_max"] * R,
-                      indenter_radius=p["indenter_radius"] * R if p["scene"] == "rigid_sphere"
-                      else math.inf)
+        R_ind = p["indenter_radius"] * R if p["scene"] == "rigid_sphere" else math.inf
+        inputs.update(h_max=p["h_max"] * min(R, R_ind), indenter_radius=R_ind)
+    if p.get("edge_band", 0.0) > 0:
+        inputs["edge_band"] = p["edge_band"]
+    if p.get("cycles"):
+        unit = inputs["h_max"] / p["h_max"]
+        inputs["unload_at"] = [float(f"{c * unit:.12g}") for c in p["cycles"]
+                              if c * unit <= inputs["h_max"] * (1 + 1e-12)]
     return inputs
 
 
+def _sample(entry: dict, where: str) -> list[dict]:
+    """Points of a ``sample = {method, n, seed}`` table over the parameters given as ranges,
+    ``{range = [lo, hi]}`` (uniform) or ``{log = [lo, hi]}`` (uniform in log): a scrambled
+    Sobol sequence (n a power of 2) or a Latin hypercube, seeded, values rounded to
+    ``SAMPLE_DIGITS`` significant digits."""
+    spec = entry.get("sample")
+    ranged = {k: v for k, v in entry.items() if isinstance(v, dict) and k not in _ENTRY_KEYS}
+    if spec is None:
+        if ranged:
+            raise ValueError(f"{where}: parameter {next(iter(ranged))} is a range but the entry has "
+                             "no sample = {{method, n, seed}} table")
+        return [{}]
+    if not isinstance(spec, dict) or set(spec) != {"method", "n", "seed"}:
+        raise ValueError(f"{where}: sample must be a table {{method, n, seed}}, got {spec!r}")
+    method, n, seed = spec["method"], spec["n"], spec["seed"]
+    if method not in SAMPLERS:
+        raise ValueError(f"{where}: sample.method must be one of {list(SAMPLERS)}, got {method!r}")
+    if not (isinstance(n, int) and n >= 1) or (method == "sobol" and n & (n - 1)):
+        raise ValueError(f"{where}: sample.n must be an integer >= 1 (a power of 2 for sobol), got {n!r}")
+    if not isinstance(seed, int):
+        raise ValueError(f"{where}: sample.seed must be an integer, got {seed!r}")
+    if not ranged:
+        raise ValueError(f"{where}: sample needs parameters given as {{range = [lo, hi]}} or "
+                         "{log = [lo, hi]}")
+    bounds = []
+    for name, r in ranged.items():
+        kind = next(iter(r)) if len(r) == 1 else None
+        lims = r.get(kind) if kind in ("range", "log") else None
+        if not (isinstance(lims, list) and len(lims) == 2 and all(
+                isinstance(x, int | float) and not isinstance(x, bool) for x in lims) and lims[0] < lims[1]
+                and (kind == "range" or lims[0] > 0)):
+            raise ValueError(f"{where}: parameter {name} must be {{range = [lo, hi]}} or {{log = [lo, hi]}} "
+                             f"with lo < hi (lo > 0 for log), got {r!r}")
+        bounds.append((name, kind, float(lims[0]), float(lims[1])))
+    d = len(bounds)
+    engine = qmc.Sobol(d, scramble=True, seed=seed) if method == "sobol" else qmc.LatinHypercube(d, seed=seed)
+    unit = engine.random(n)
+    points = []
+    for row in unit:
+        pt = {}
+        for u, (name, kind, lo, hi) in zip(row, bounds, strict=True):
+            x = math.exp(math.log(lo) + u * math.log(hi / lo)) if kind == "log" else lo + u * (hi - lo)
+            pt[name] = float(f"{x:.{SAMPLE_DIGITS}g}")
+        points.append(pt)
+    return points
+
+
 def _expand(entry: dict, where: str) -> list[dict]:
-    """Grid expansion: list-valued parameters → their product (entry order, last fastest)."""
+    """Grid expansion: list-valued parameters → their product (entry order, last fastest),
+    times the points of a ``sample`` table (:func:`_sample`)."""
     axes = []
     for name, value in entry.items():
+        if name in _ENTRY_KEYS or isinstance(value, dict):
+            continue
         if isinstance(value, list):
             if not value:
                 raise ValueError(f"{where}: parameter {name} is an empty list")
@@ -301,10 +452,12 @@ def _expand(entry: dict, where: str) -> list[dict]:
             axes.append([(name, v) for v in value])
         else:
             axes.append([(name, value)])
-    return [dict(point) for point in itertools.product(*axes)]
+    fixed = {k: v for k, v in entry.items() if k in _ENTRY_KEYS and k != "sample"}
+    return [{**dict(point), **sampled, **fixed}
+            for point in itertools.product(*axes) for sampled in _sample(entry, where)]
 
 
-def _cases_of_set(set_name: str, entries, defaults: dict) -> list[Case]:
+def _cases_of_set(set_name: str, entries, defaults: dict, curves: dict | None = None) -> list[Case]:
     if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
         hint = "; parameters go in [defaults] or in entries" if set_name in PARAMETERS else ""
         raise ValueError(f"top-level key {set_name!r} must be a set, an array of tables "
@@ -316,10 +469,10 @@ def _cases_of_set(set_name: str, entries, defaults: dict) -> list[Case]:
         if "options" in entry and not isinstance(entry["options"], dict):
             raise ValueError(f"{where}: options must be a table of solver options")
         for point in _expand(entry, where):
-            p, options = _resolve(point, defaults, where)
+            p, options = _resolve(point, defaults, where, curves)
             wall = p.pop("max_wall_s")
             cases.append(Case(set=set_name, name=_name(p, defaults), entry=where, params=p,
-                              inputs=_inputs(p, options), max_wall_s=wall))
+                              inputs=_inputs(p, options, curves), max_wall_s=wall))
     return cases
 
 
@@ -355,12 +508,18 @@ def parse_campaign(text: str, source: str = "<campaign>") -> Campaign:
             raise ValueError("[defaults] must be a table")
         _check_keys(defaults, "[defaults]")
         for name, value in defaults.items():
+            if name == "cycles":
+                _check_cycles(value, "[defaults]")
+                continue
+            if name == "flow_curve":
+                continue
             if isinstance(value, list):
                 raise ValueError(f"[defaults]: {name} must be a single value (grids go in entries)")
             if name != "options":
                 PARAMETERS[name].check(name, value, "[defaults]")
         if "options" in defaults:
             _check_options(defaults["options"], "[defaults]")
+        curves = _check_curves(doc)
         sets = [k for k in doc if k not in _SETS_RESERVED]
         if not sets:
             raise ValueError("no sets: add entries such as [[calibration]] and [[validation]]")
@@ -368,7 +527,7 @@ def parse_campaign(text: str, source: str = "<campaign>") -> Campaign:
         for name in sets:
             if not name.replace("_", "").replace("-", "").isalnum():
                 raise ValueError(f"set name {name!r} must be letters, digits, '_' or '-'")
-            cases += _cases_of_set(name, doc[name], defaults)
+            cases += _cases_of_set(name, doc[name], defaults, curves)
         _check_unique(cases)
     except ValueError as err:
         raise ValueError(f"{source}: {err}") from None

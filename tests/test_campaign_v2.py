@@ -1,0 +1,121 @@
+"""Campaign format v2: space-filling samples, tabulated and saturating flow curves, unloading
+cycles and the surface band; the shipped v2 design."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spherecontact.data import Database
+from spherecontact.fem.design import load_campaign, parse_campaign
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAD = '[defaults]\nh_max = 0.3\n'
+SOBOL = '''
+[[s]]
+scene = "flat"
+sample = { method = "sobol", n = 8, seed = 3 }
+E_over_sigma_y = { log = [10, 10000] }
+K_over_sigma_y = { range = [0, 10] }
+n = 0.3
+'''
+
+
+def test_sample_is_seeded_space_filling_and_in_range():
+    a = parse_campaign(HEAD + SOBOL).cases
+    b = parse_campaign(HEAD + SOBOL).cases
+    assert [c.key for c in a] == [c.key for c in b]  # same seed, same design
+    E = np.array([c.params["E_over_sigma_y"] for c in a])
+    K = np.array([c.params["K_over_sigma_y"] for c in a])
+    assert len(a) == 8 and np.all((E >= 10) & (E <= 10000)) and np.all((K >= 0) & (K <= 10))
+    # space filling: every decade of E/σY and every quarter of K holds points
+    assert set(np.floor(np.log10(E)).astype(int)) == {1, 2, 3}
+    assert len(set(np.floor(K / 2.5).astype(int))) == 4
+    other = parse_campaign(HEAD + SOBOL.replace("seed = 3", "seed = 4")).cases
+    assert {c.key for c in other}.isdisjoint({c.key for c in a})
+
+
+@pytest.mark.parametrize("old, new, message", [
+    ("n = 8", "n = 6", "power of 2"),
+    ("{ log = [10, 10000] }", "{ log = [0, 10] }", "E_over_sigma_y must be"),
+    ('method = "sobol"', 'method = "grid"', "sample.method"),
+])
+def test_bad_samples_are_named(old, new, message):
+    with pytest.raises(ValueError, match=message):
+        parse_campaign(HEAD + SOBOL.replace(old, new))
+
+
+def test_range_without_sample_is_an_error():
+    with pytest.raises(ValueError, match="no sample"):
+        parse_campaign(HEAD + '[[s]]\nscene = "flat"\nE_over_sigma_y = { log = [10, 100] }\n')
+
+
+CURVE = '''
+[flow_curves.metal]
+source = "a handbook"
+eps_p = [0, 0.1, 1.0]
+sigma_over_sigma_y = [1, 1.5, 2.0]
+[[s]]
+scene = "flat"
+flow_curve = "metal"
+E_over_sigma_y = 500
+'''
+
+
+def test_named_flow_curve_becomes_a_table():
+    (case,) = parse_campaign(HEAD + CURVE).cases
+    assert case.inputs["material"]["sigma_table"] == [1.0, 1.5, 2.0]
+    assert case.run_kwargs()["material"].is_tabulated
+    assert case.name.startswith("flat-metal-E500")
+    with pytest.raises(ValueError, match="'steel' is not a table"):
+        parse_campaign(HEAD + CURVE.replace('flow_curve = "metal"', 'flow_curve = "steel"'))
+    with pytest.raises(ValueError, match="replaces K_over_sigma_y"):
+        parse_campaign(HEAD + CURVE + "K_over_sigma_y = 2\n")
+    with pytest.raises(ValueError, match="must start at 1"):
+        parse_campaign(HEAD + CURVE.replace("[1, 1.5, 2.0]", "[2, 2.5, 3.0]"))
+
+
+def test_voce_saturation_is_tabulated_accurately():
+    (case,) = parse_campaign(HEAD + '[[s]]\nscene = "flat"\nE_over_sigma_y = 300\n'
+                                    'Q_over_sigma_y = 2\nb = 20\n').cases
+    mat = case.run_kwargs()["material"]
+    eps = np.geomspace(1e-4, 2.0, 200)
+    exact = 1.0 + 2.0 * (1.0 - np.exp(-20.0 * eps))
+    assert np.max(np.abs(mat.flow_stress(eps) / exact - 1)) < 2e-3
+    assert "voceQ2-b20" in case.name
+
+
+def test_cycles_scale_with_the_smaller_radius_and_defaults_keep_old_keys():
+    text = HEAD + 'cycles = [0.01, 0.1, 0.3]\nedge_band = 0.03\n[[s]]\nscene = "rigid_sphere"\n' \
+                  'indenter_radius = 0.5\nE_over_sigma_y = 100\n'
+    (case,) = parse_campaign(text).cases
+    assert case.inputs["h_max"] == pytest.approx(0.15)
+    assert case.inputs["unload_at"] == pytest.approx([0.005, 0.05, 0.15])
+    assert case.run_kwargs()["edge_band"] == 0.03
+    (plain,) = parse_campaign(HEAD + '[[s]]\nscene = "flat"\nE_over_sigma_y = 100\n').cases
+    assert "unload_at" not in plain.inputs and "edge_band" not in plain.inputs
+    with pytest.raises(ValueError, match="cycles must increase"):
+        parse_campaign(text.replace("[0.01, 0.1, 0.3]", "[0.1, 0.01]"))
+
+
+def test_v1_campaign_keys_still_match_its_database():
+    db = Database(ROOT / "data" / "reference.h5")
+    cases = load_campaign(ROOT / "data" / "campaign.toml").cases
+    missing = [c.name for c in cases if c.key not in db]
+    assert missing == ["rsphere0.5-K2-n0.4-E600-nu0.3"]  # h_max now of the smaller radius: 0.15
+
+
+def test_shipped_v2_design():
+    c = load_campaign(ROOT / "data" / "campaign_v2.toml")
+    cal, val = c.select({"calibration"}), c.select({"validation"})
+    assert len(cal) >= 80 and len(val) >= 30
+    assert not {x.key for x in cal} & {x.key for x in val}
+    assert all(x.params["h_max"] == 0.3 and len(x.inputs["unload_at"]) == 4 for x in c.cases)
+    metals = {x.params["flow_curve"] for x in val if x.params["flow_curve"]}
+    assert len(metals) >= 3 and not any(x.params["flow_curve"] for x in cal)
+    ratios = {round(x.params.get("indenter_radius", x.params.get("radius2", 1)), 3) for x in val}
+    assert {3.0, 0.333} <= ratios
+    assert any(x.params.get("sigma_y2_over_sigma_y1") == 5 for x in val)
+    assert any(x.params["K_over_sigma_y"] == 5 for x in val)
+    E = [x.params["E_over_sigma_y"] for x in cal]
+    assert min(E) == 10 and max(E) == 10000
