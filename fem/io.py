@@ -9,20 +9,41 @@ version 1), so a database can later copy it as one group among many
                                      provenance.* (versions, git commit, host, date,
                                      wall time, timings.*, newton.*, extra.*)
       curves/<name>           (n_inc,)   one per recorded curve; attrs units, description
-      newton/residuals        (n_res,)   relative residual norms of all increments, concatenated
+      newton/residuals        (n_res,)   relative residual norms of all increments, concatenated (float32)
       newton/offsets          (n_inc+1,) increment k owns residuals[offsets[k]:offsets[k+1]]
-      profiles/r              (n_inc, n_surf) deformed radius of the surface nodes
-      profiles/p              (n_inc, n_surf) contact pressure
-      profiles/gap            (n_inc, n_surf) gap to the obstacle (0 where in contact)
+      profiles/increment      (n_prof,)  int32: the increment each profile row belongs to (increasing)
+      profiles/r              (n_prof, n_surf) deformed radius of the surface nodes (float32)
+      profiles/p              (n_prof, n_surf) contact pressure (float32)
+      profiles/gap            (n_prof, n_surf) gap to the obstacle, 0 where in contact (float32)
       mesh/X                  (2, n_nodes) reference coordinates (r, z)
       mesh/u                  (2 n_nodes,) final displacement, interleaved (u_r, u_z)
       mesh/cells              (n_el, 8|4) node indices
-      mesh/eps_p              (n_el, n_qp) final equivalent plastic strain at the Gauss points
+      mesh/eps_p              (n_el, n_qp) final equivalent plastic strain at the Gauss points (float32)
       cycles/<name>           (n_cyc,) or (n_cyc, n_surf) per unloading branch (``CYCLES``);
                               present only in runs with unloading cycles
 
 Increments are stored in the order computed; ``curves/branch`` labels each one
 (0 load, 1 unload, 2 reload: elastic reloading below the largest approach reached).
+
+Profiles are kept at ``n_prof <= PROFILE_ROWS`` increments (:func:`profile_increments`):
+the first and the last, both sides of every change of ``curves/branch`` (start and end
+of each loading, unloading and reloading branch: the unloading peaks and the residual
+states), the rest spread evenly in log h over the loading increments. A run with more
+than ``(PROFILE_ROWS - 2) / 6`` cycles keeps every branch change and exceeds the limit.
+Files written before (no ``profiles/increment``) hold every increment and read as
+``increment = arange(n_inc)``.
+
+Precision, chosen from what takes the space (data/reference.h5: float64 profiles at
+every increment were ~70 % of 28 MB of data for 35 runs): every curve and ``cycles/*``
+stay float64 (the data calibration and validation fit); ``mesh/X`` and ``mesh/u`` stay
+float64 too (about 100 kB of a 250 kB run; exact reference geometry, so X + u is the
+computed deformed mesh); the profiles, the Newton residual histories and the plastic
+strain field are float32 (diagnostics and pictures): rounded to nearest, relative error
+<= 2**-24 = 6.0e-8 (measured <= 5.92e-8 on runs to h/R = 0.3); writing raises ValueError
+if a finite value overflows float32. The reader returns them as float64 arrays holding
+the stored values. Arrays above ``COMPRESS_ABOVE`` bytes are gzip(4)+shuffle compressed.
+A run to h/R = 0.3 (E/sigma_y = 200, default mesh) takes ~257 kB, with 4 unloading
+cycles ~304 kB (660 and 1010 kB before).
 
 Units are consistent: lengths in the unit of the radius, stresses in the unit
 of E, forces = stress × length², energies = force × length.
@@ -47,7 +68,7 @@ import numpy as np
 from ..model.material import Material
 from .assembly import ELEMENTS
 from .contact import RigidObstacle
-from .mesh import DENSITY_RANGE
+from .mesh import DENSITY_RANGE, EDGE_BAND_MAX
 from .solver import IndentationSolver, RunResult, SolverOptions, check_unload_at
 from .twobody import TwoBodySolver
 
@@ -55,7 +76,7 @@ __all__ = [
     "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "SCENES", "Run", "check_inputs", "choose_scene",
     "run_indentation",
     "write_run", "write_run_group", "read_run", "run_from_group", "provenance",
-    "material_from_description",
+    "material_from_description", "PROFILE_ROWS", "profile_increments",
 ]
 
 SCHEMA = "spherecontact.fem.run"
@@ -127,6 +148,10 @@ REQUIRED_CURVES = ("h", "F", "F_support", "a", "a_nodes", "a_ref", "p_m", "eps_p
                    "active_changes")
 PROFILES = {"r": "profile_r", "p": "profile_p", "gap": "profile_g"}
 PROFILE_UNITS = {"r": "length", "p": "stress", "gap": "length"}
+#: surface profiles stored per run (more only when a run has more branch changes)
+PROFILE_ROWS = 40
+#: on-disk dtype of the diagnostic arrays (profiles, residual histories, plastic strain field)
+COMPACT = np.float32
 MESH = ("X", "u", "cells", "eps_p")
 CELL_TYPES = {8: "quad8", 4: "quad"}
 NODE_ORDER = {
@@ -194,7 +219,7 @@ def choose_scene(material, radius, material2=None, radius2=None,
 
 def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
                  element="q8r", options=None, progress=None, radius2=None, material2=None,
-                 scene="auto", unload_at=None) -> dict:
+                 scene="auto", unload_at=None, edge_band=0.0) -> dict:
     """Validate every input of :func:`run_indentation`; return them normalised.
 
     Raises ValueError naming the parameter and its allowed range.
@@ -233,6 +258,10 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
         raise ValueError(f"mesh density must lie in [{lo:g}, {hi:g}], got {density!r}")
     if element not in ELEMENTS:
         raise ValueError(f"element must be one of {sorted(ELEMENTS)}, got {element!r}")
+    band = _as_float(edge_band)
+    if not (math.isfinite(band) and 0.0 <= band <= EDGE_BAND_MAX):
+        raise ValueError(f"edge_band must lie in [0, {EDGE_BAND_MAX:g}] (0: no surface band), "
+                         f"got {edge_band!r}")
     options = SolverOptions() if options is None else options
     if not isinstance(options, SolverOptions):
         raise ValueError(f"options must be a SolverOptions, got {type(options).__name__}")
@@ -241,7 +270,7 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
         raise ValueError("progress must be a callable progress(h) or None")
     unload = check_unload_at(unload_at, h)
     return {"material": material, "radius": R, "h_max": h, "indenter_radius": R_ind,
-            "density": d, "element": element, "options": options, "progress": progress,
+            "density": d, "element": element, "edge_band": band, "options": options, "progress": progress,
             "material2": material2, "radius2": R2, "scene": chosen,
             "unload_at": unload if unload.size else None}
 
@@ -281,7 +310,7 @@ def run_indentation(material: Material, radius: float, h_max: float,
                     element: str = "q8r", options: SolverOptions | None = None,
                     progress: Callable[[float], object] | None = None,
                     radius2: float | None = None, material2: Material | None = None,
-                    scene: str = "auto", schedule=None, unload_at=None) -> RunResult:
+                    scene: str = "auto", schedule=None, unload_at=None, edge_band: float = 0.0) -> RunResult:
     """Press a hemisphere of ``radius`` and ``material`` on its partner up to ``h_max``.
 
     Partner: ``indenter_radius`` (rigid flat for inf, else a rigid sphere), or body 2
@@ -295,18 +324,20 @@ def run_indentation(material: Material, radius: float, h_max: float,
     converged increment. ``schedule`` (one-body scenes): the approaches to step to
     instead of adaptive increments (``IndentationSolver.run``). ``unload_at``: increasing
     approaches in (0, h_max] at which the pair is unloaded until the force vanishes and then
-    reloaded (labels in ``curves["branch"]``, summaries in ``cycles``).
+    reloaded (labels in ``curves["branch"]``, summaries in ``cycles``). ``edge_band``: surface
+    element size per unit distance from the pole (``build_mesh``; 0: the default mesh).
     Returns the solver's ``RunResult``.
     """
     a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
-                     progress, radius2, material2, scene, unload_at)
+                     progress, radius2, material2, scene, unload_at, edge_band)
     unload_at = a["unload_at"]
     chosen = a["scene"]
     if chosen == "two_body":
         if schedule is not None:
             raise ValueError("schedule: prescribed increments exist for the one-body scenes only")
         solver = TwoBodySolver(a["material"], a["radius"], a["material2"], a["radius2"],
-                               density=a["density"], element=a["element"], options=a["options"])
+                               density=a["density"], element=a["element"], options=a["options"],
+                               edge_band=a["edge_band"])
         return solver.run(a["h_max"], progress=a["progress"], unload_at=unload_at)
     h_run, progress = a["h_max"], a["progress"]
     if chosen == "equal_pair_symmetry":
@@ -318,7 +349,8 @@ def run_indentation(material: Material, radius: float, h_max: float,
                 return outer(2.0 * h)
     solver = IndentationSolver(a["material"], a["radius"],
                                obstacle=RigidObstacle(a["indenter_radius"]),
-                               density=a["density"], element=a["element"], options=a["options"])
+                               density=a["density"], element=a["element"], options=a["options"],
+                               edge_band=a["edge_band"])
     if schedule is not None and chosen == "equal_pair_symmetry":
         schedule = 0.5 * np.asarray(schedule, dtype=float)
     if unload_at is not None and chosen == "equal_pair_symmetry":
@@ -469,6 +501,92 @@ def _ragged(lists) -> tuple[np.ndarray, np.ndarray]:
     return values, offsets
 
 
+def _compact(values, name: str) -> np.ndarray:
+    """``values`` as ``COMPACT`` (float32); ValueError naming ``name`` if a finite value overflows."""
+    arr = np.asarray(values, dtype=float)
+    with np.errstate(over="ignore"):
+        out = arr.astype(COMPACT)
+    if np.any(np.isfinite(arr) & ~np.isfinite(out)):
+        raise ValueError(f"{name}: values beyond the float32 range ({np.finfo(COMPACT).max:.3g})")
+    return out
+
+
+def _branch_ends(branch: np.ndarray) -> np.ndarray:
+    """Increments on both sides of every change of ``branch`` (ends and starts of branches)."""
+    after = np.flatnonzero(np.diff(branch) != 0) + 1
+    return np.union1d(after - 1, after)
+
+
+def _nearest(x: np.ndarray, k: int) -> np.ndarray:
+    """Distinct indices of the entries of increasing ``x`` nearest to ``k`` values evenly
+    spaced over [x[0], x[-1]]."""
+    t = np.linspace(x[0], x[-1], k)
+    j = np.clip(np.searchsorted(x, t), 1, x.size - 1)
+    j -= (t - x[j - 1]) < (x[j] - t)
+    return np.unique(j)
+
+
+def profile_increments(h, branch=None, rows: int = PROFILE_ROWS) -> np.ndarray:
+    """The increments whose surface profiles are stored: sorted int32 indices into ``h``.
+
+    All of them when there are at most ``rows``; else the first and last increment,
+    both sides of every change of ``branch`` (0 load, 1 unload, 2 reload; None: all
+    loading), and loading increments spread evenly in log h up to ``rows`` in total.
+    Every branch change is kept even when they alone exceed ``rows``.
+    """
+    if isinstance(rows, bool) or not isinstance(rows, int | np.integer) or rows < 2:
+        raise ValueError(f"rows must be an integer >= 2, got {rows!r}")
+    h = np.asarray(h, dtype=float)
+    if h.ndim != 1:
+        raise ValueError(f"h must be one-dimensional, got shape {h.shape}")
+    branch = np.zeros(h.size, dtype=np.int64) if branch is None else np.asarray(branch)
+    if branch.shape != h.shape:
+        raise ValueError(f"branch must have the shape {h.shape} of h, got {branch.shape}")
+    n = h.size
+    if n <= rows:
+        return np.arange(n, dtype=np.int32)
+    fixed = np.union1d([0, n - 1], _branch_ends(branch))
+    load = np.flatnonzero((branch == 0) & (h > 0))
+    load = load[np.argsort(h[load], kind="stable")]
+    return _fill_log(fixed, load, np.log(h[load]), rows).astype(np.int32)
+
+
+def _fill_log(fixed: np.ndarray, load: np.ndarray, x: np.ndarray, rows: int) -> np.ndarray:
+    """``fixed`` plus the ``load`` increments nearest to k targets evenly spaced in ``x`` (log h),
+    k as large as ``rows`` allows (bisection between 2 and a spacing that hits every one)."""
+    best = fixed
+    if x.size < 2 or x[-1] <= x[0]:
+        return best
+    gaps = np.diff(x)
+    lo, hi = 2, int(min(2 * (x[-1] - x[0]) / gaps[gaps > 0].min() + 2, 1000 * rows))
+    while lo <= hi:
+        k = (lo + hi) // 2
+        trial = np.union1d(fixed, load[_nearest(x, k)])
+        if trial.size > rows:
+            hi = k - 1
+            continue
+        best = trial if trial.size >= best.size else best
+        lo = k + 1
+    return best
+
+
+def _write_profiles(g: h5py.Group, result: RunResult) -> None:
+    """The surface profiles at :func:`profile_increments` (float32) and their increments."""
+    idx = profile_increments(result.curves["h"], result.curves.get("branch"), PROFILE_ROWS)
+    profiles = g.create_group("profiles")
+    profiles.attrs["description"] = ("surface node from the pole (columns) at the increments "
+                                     "profiles/increment (rows)")
+    _dataset(profiles, "increment", idx, units="index",
+             description="increment of each row: first, last, both sides of every branch change, "
+                         "loading increments spread in log h")
+    for pname, attr in PROFILES.items():
+        values = np.asarray(getattr(result, attr), dtype=float)
+        if values.ndim != 2 or values.shape[0] != np.size(result.curves["h"]):
+            raise ValueError(f"result.{attr} must have one row per increment "
+                             f"({np.size(result.curves['h'])}), got shape {values.shape}")
+        _dataset(profiles, pname, _compact(values[idx], f"result.{attr}"), units=PROFILE_UNITS[pname])
+
+
 def write_run_group(parent: h5py.Group, name: str, result: RunResult,
                     prov: dict | None = None) -> h5py.Group:
     """Write ``result`` as the group ``parent[name]`` (layout in the module docstring).
@@ -496,15 +614,11 @@ def write_run_group(parent: h5py.Group, name: str, result: RunResult,
         _dataset(curves, cname, np.asarray(values), units=unit, description=description)
     newton = g.create_group("newton")
     values, offsets = _ragged(result.residuals)
-    _dataset(newton, "residuals", values, units="1",
-             description="relative residual norms per Newton iteration, all increments")
+    _dataset(newton, "residuals", _compact(values, "result.residuals"), units="1",
+             description="relative residual norms per Newton iteration, all increments (float32)")
     _dataset(newton, "offsets", offsets, units="index",
              description="increment k owns residuals[offsets[k]:offsets[k+1]]")
-    profiles = g.create_group("profiles")
-    profiles.attrs["description"] = "per increment (rows) and surface node from the pole (columns)"
-    for pname, attr in PROFILES.items():
-        _dataset(profiles, pname, np.asarray(getattr(result, attr), dtype=float),
-                 units=PROFILE_UNITS[pname])
+    _write_profiles(g, result)
     _write_mesh(g, result.final)
     if getattr(result, "cycles", None):
         cyc = g.create_group("cycles")
@@ -526,8 +640,8 @@ def _write_mesh(g: h5py.Group, final: dict) -> None:
     _dataset(mesh, "u", np.asarray(final["u"], dtype=float), units="length",
              description="final displacement, interleaved (u_r, u_z) per node")
     _dataset(mesh, "cells", cells, units="index", description="node indices per element")
-    _dataset(mesh, "eps_p", np.asarray(final["eps_p"], dtype=float), units="1",
-             description="final equivalent plastic strain at the 2x2 Gauss points")
+    _dataset(mesh, "eps_p", _compact(final["eps_p"], "final['eps_p']"), units="1",
+             description="final equivalent plastic strain at the 2x2 Gauss points (float32)")
 
 
 def _temporary_sibling(path: Path) -> Path:
@@ -582,7 +696,10 @@ class Run:
 
     ``h``, ``F``, ``a`` and every other curve (``run.p_m``, ``run.dissipation``, …)
     are attributes; ``curves`` maps names to the same arrays. ``residuals[k]`` is
-    the Newton residual history of increment k. Arrays are read-only.
+    the Newton residual history of increment k. ``profile_r/_p/_gap`` row i is the
+    surface at increment ``profile_increment[i]`` (a subset of the increments in files
+    written with ``profiles/increment``; every increment in older files and by default).
+    Arrays are read-only; float32 data come as float64.
     """
 
     inputs: dict
@@ -597,6 +714,14 @@ class Run:
     mesh: dict
     source: str = ""
     cycles: dict = field(default_factory=dict)
+    profile_increment: np.ndarray | None = None
+
+    def __post_init__(self):
+        """Default ``profile_increment``: one profile row per increment."""
+        if self.profile_increment is None:
+            idx = np.arange(np.shape(self.profile_r)[0])
+            idx.setflags(write=False)
+            object.__setattr__(self, "profile_increment", idx)
 
     def __getattr__(self, name: str):
         """Curves as attributes (only called when normal lookup fails)."""
@@ -665,6 +790,24 @@ class Run:
         return SolverOptions(**{k: v for k, v in self.inputs.get("options", {}).items()
                                 if k in known})
 
+    @property
+    def profile_h(self) -> np.ndarray:
+        """Approach at each stored profile row."""
+        return self.curves["h"][self.profile_increment]
+
+    def profile(self, increment: int) -> dict:
+        """``{"r", "p", "gap"}`` of the surface at ``increment`` (negative: from the end).
+
+        ValueError naming the increment when its profile was not stored.
+        """
+        k = int(increment) + (self.n_increments if increment < 0 else 0)
+        row = np.flatnonzero(self.profile_increment == k)
+        if row.size != 1:
+            raise ValueError(f"increment {increment}: no stored profile; stored increments are "
+                             f"{self.profile_increment.tolist()}")
+        i = int(row[0])
+        return {"r": self.profile_r[i], "p": self.profile_p[i], "gap": self.profile_gap[i]}
+
     def deformed(self) -> np.ndarray:
         """Final deformed node coordinates, shape (2, n_nodes)."""
         X = self.mesh["X"]
@@ -679,11 +822,13 @@ def _require(g: h5py.Group, names) -> None:
 
 
 def _read_array(g: h5py.Group, name: str) -> np.ndarray:
-    """Dataset ``g[name]`` as a read-only array (ValueError if it is not a dataset)."""
+    """Dataset ``g[name]`` as a read-only array, float32 as float64 (ValueError if not a dataset)."""
     obj = g[name]
     if not isinstance(obj, h5py.Dataset):
         raise ValueError(f"{obj.name!r} must be a dataset")
     arr = np.asarray(obj[()])
+    if arr.dtype.kind == "f" and arr.dtype.itemsize < 8:
+        arr = arr.astype(np.float64)
     arr.setflags(write=False)
     return arr
 
@@ -705,8 +850,8 @@ def _check_header(g: h5py.Group) -> None:
             raise ValueError(f"run group {g.name!r} lacks the attribute {key!r}")
 
 
-def _check_shapes(curves: dict, offsets, values, profiles: dict, mesh: dict) -> None:
-    """Consistency of the curve lengths, the ragged residuals, profiles and mesh."""
+def _check_shapes(curves: dict, offsets, values, mesh: dict) -> None:
+    """Consistency of the curve lengths, the ragged residuals and the mesh."""
     n = curves["h"].size
     bad = [k for k, v in curves.items() if v.shape != (n,)]
     if bad:
@@ -714,15 +859,33 @@ def _check_shapes(curves: dict, offsets, values, profiles: dict, mesh: dict) -> 
     if offsets.shape != (n + 1,) or offsets[0] != 0 or np.any(np.diff(offsets) < 0) \
             or offsets[-1] != values.size:
         raise ValueError("newton/offsets is not a valid index into newton/residuals")
-    for name, arr in profiles.items():
-        if arr.ndim != 2 or arr.shape[0] != n:
-            raise ValueError(f"profiles/{name} must have {n} rows, got shape {arr.shape}")
     X, u, cells, eps_p = (mesh[k] for k in MESH)
     if X.ndim != 2 or X.shape[0] != 2 or u.shape != (2 * X.shape[1],):
         raise ValueError(f"mesh/X {X.shape} and mesh/u {u.shape} are inconsistent")
     if cells.ndim != 2 or eps_p.shape[:1] != cells.shape[:1] or \
             (cells.size and (cells.min() < 0 or cells.max() >= X.shape[1])):
         raise ValueError("mesh/cells or mesh/eps_p do not match mesh/X")
+
+
+def _read_profiles(g: h5py.Group, n: int) -> tuple[dict, np.ndarray]:
+    """Profiles and the increment of each row (``arange(n)`` in files without ``increment``)."""
+    profiles = {name: _read_array(g, name) for name in PROFILES}
+    if "increment" in g:
+        idx = _read_array(g, "increment")
+        where = "profiles/increment"
+    else:  # written before profiles/increment existed: one row per increment
+        idx = np.arange(n)
+        idx.setflags(write=False)
+        where = "curves/h (one row per increment)"
+    if idx.ndim != 1 or (idx.size and (idx.dtype.kind not in "iu" or idx[0] < 0 or idx[-1] >= n
+                                       or np.any(np.diff(idx) <= 0))):
+        raise ValueError(f"profiles/increment must be increasing increment indices in [0, {n}), "
+                         f"got {idx.tolist()}")
+    for name, arr in profiles.items():
+        if arr.ndim != 2 or arr.shape[0] != idx.size:
+            raise ValueError(f"profiles/{name} must have {idx.size} rows ({where}), "
+                             f"got shape {arr.shape}")
+    return profiles, idx
 
 
 def run_from_group(g: h5py.Group, source: str = "") -> Run:
@@ -736,16 +899,16 @@ def run_from_group(g: h5py.Group, source: str = "") -> Run:
     curves = {name: _read_array(g["curves"], name) for name in g["curves"]}
     values = _read_array(g["newton"], "residuals")
     offsets = _read_array(g["newton"], "offsets")
-    profiles = {name: _read_array(g["profiles"], name) for name in PROFILES}
     mesh = {name: _read_array(g["mesh"], name) for name in MESH}
-    _check_shapes(curves, offsets, values, profiles, mesh)
+    _check_shapes(curves, offsets, values, mesh)
+    profiles, increment = _read_profiles(g["profiles"], curves["h"].size)
     cycles = {name: _read_array(g["cycles"], name) for name in g["cycles"]} if "cycles" in g else {}
     residuals = [values[offsets[k]:offsets[k + 1]] for k in range(offsets.size - 1)]
     return Run(inputs=_unflatten(g.attrs, INPUT_PREFIX), curves=curves,
                status=_python_value(g.attrs["status"]), reason=_python_value(g.attrs["reason"]),
                provenance=_unflatten(g.attrs, PROVENANCE_PREFIX), residuals=residuals,
                profile_r=profiles["r"], profile_p=profiles["p"], profile_gap=profiles["gap"],
-               mesh=mesh, source=source, cycles=cycles)
+               mesh=mesh, source=source, cycles=cycles, profile_increment=increment)
 
 
 def read_run(path, group: str = GROUP) -> Run:

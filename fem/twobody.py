@@ -586,7 +586,8 @@ class TwoBodySolver(CycleLegs):
         inputs = {"scene": "two_body", "material": b1.material.describe(), "radius": b1.radius,
                   "material2": b2.material.describe(), "radius2": b2.radius,
                   "indenter_radius": b2.radius, "h_max": h_max,
-                  "mesh_density": b1.hmesh.density, "edge_band": b1.hmesh.edge_band, "element": b1.disc.element,
+                  "mesh_density": b1.hmesh.density, "edge_band": b1.hmesh.edge_band,
+                  "element": b1.disc.element,
                   "n_elements": b1.disc.n_elements + b2.disc.n_elements, "n_dofs": self.n_dofs,
                   "slave_body": self.slave_index + 1, "options": self.options.as_inputs()}
         return RunResult(inputs=inputs, curves=curves, residuals=residuals,
