@@ -140,7 +140,8 @@ def _multiplier_power(q_tr, eps_p_n, material: Material, mu: float, tol: float, 
 
     dσ_f/dε_p is unbounded at ε_p → 0, but in y the residual
     q_tr − 3μ (y^(1/n) − ε_p,n) − σ_Y − K y is smooth with slope −3μ y^(1/n−1)/n − K,
-    so bracketed Newton converges at the onset of yield too.
+    so bracketed Newton converges at the onset of yield too. A point is converged where
+    |residual| ≤ tol σ_Y or its bracket has shrunk to the roundoff of y.
     """
     n, K, sy = material.n, material.K, material.sigma_y
     lo = eps_p_n**n
@@ -148,7 +149,9 @@ def _multiplier_power(q_tr, eps_p_n, material: Material, mu: float, tol: float, 
     y = lo.copy()
     for _ in range(maxit):
         r = q_tr - 3.0 * mu * (y ** (1.0 / n) - eps_p_n) - sy - K * y
-        done = np.abs(r) <= tol * sy
+        # converged, or the bracket has shrunk to the roundoff of y (3μ y^(1/n) cancels ε_p,n:
+        # at E/σY = 1e4 and ε_p ~ 1 its roundoff alone is ~1e-12 σY)
+        done = (np.abs(r) <= tol * sy) | (hi - lo <= 4e-16 * y + 1e-300)
         if np.all(done):
             break
         lo = np.where(r > 0, y, lo)

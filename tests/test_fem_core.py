@@ -218,3 +218,18 @@ def test_work_increment_exact_for_power_laws():
         exact = 3.0 * (0.2 ** (p + 1) - 0.1 ** (p + 1)) / (p + 1)
         assert work_increment(0.1, 0.2, F(0.1), F(0.2)) == pytest.approx(exact, rel=1e-12)
     assert work_increment(0.0, 0.1, 0.0, 2.0) == pytest.approx(2.0 * 0.1 / 2.5)
+
+
+def test_power_law_multiplier_converges_at_the_roundoff_floor():
+    """Ludwik n = 0.1 at E/σY = 1e4 and ε_p ~ 1: 3μ y^(1/n) cancels ε_p,n, so the residual
+    cannot fall below ~1e-12 σY; the bracket's collapse ends the iteration (it used to raise
+    "plastic multiplier did not converge" and stop the run)."""
+    from spherecontact.fem.plasticity import solve_plastic_multiplier
+
+    mat = Material(E=1e4, nu=0.3, sigma_y=1.0, K=0.5, n=0.1)
+    mu = mat.shear_modulus
+    eps_n = np.array([0.3, 0.8, 1.5, 2.5])
+    dg = np.array([1e-6, 1e-4, 1e-3, 3e-3])
+    q_tr = mat.flow_stress(eps_n + dg) + 3.0 * mu * dg
+    got = solve_plastic_multiplier(q_tr, eps_n, mat, mu)
+    np.testing.assert_allclose(got, dg, rtol=1e-6, atol=1e-14)
