@@ -15,9 +15,9 @@ version 1), so a database can later copy it as one group among many
       profiles/r              (n_prof, n_surf) deformed radius of the surface nodes (float32)
       profiles/p              (n_prof, n_surf) contact pressure (float32)
       profiles/gap            (n_prof, n_surf) gap to the obstacle, 0 where in contact (float32)
-      mesh/X                  (2, n_nodes) reference coordinates (r, z)
-      mesh/u                  (2 n_nodes,) final displacement, interleaved (u_r, u_z)
-      mesh/cells              (n_el, 8|4) node indices
+      mesh/X                  (2, n_nodes) reference coordinates (r, z) (float32)
+      mesh/u                  (2 n_nodes,) final displacement, interleaved (u_r, u_z) (float32)
+      mesh/cells              (n_el, 8|4) node indices (int32)
       mesh/eps_p              (n_el, n_qp) final equivalent plastic strain at the Gauss points (float32)
       cycles/<name>           (n_cyc,) or (n_cyc, n_surf) per unloading branch (``CYCLES``);
                               present only in runs with unloading cycles
@@ -35,15 +35,15 @@ Files written before (no ``profiles/increment``) hold every increment and read a
 
 Precision, chosen from what takes the space (data/reference.h5: float64 profiles at
 every increment were ~70 % of 28 MB of data for 35 runs): every curve and ``cycles/*``
-stay float64 (the data calibration and validation fit); ``mesh/X`` and ``mesh/u`` stay
-float64 too (about 100 kB of a 250 kB run; exact reference geometry, so X + u is the
-computed deformed mesh); the profiles, the Newton residual histories and the plastic
-strain field are float32 (diagnostics and pictures): rounded to nearest, relative error
-<= 2**-24 = 6.0e-8 (measured <= 5.92e-8 on runs to h/R = 0.3); writing raises ValueError
-if a finite value overflows float32. The reader returns them as float64 arrays holding
-the stored values. Arrays above ``COMPRESS_ABOVE`` bytes are gzip(4)+shuffle compressed.
-A run to h/R = 0.3 (E/sigma_y = 200, default mesh) takes ~257 kB, with 4 unloading
-cycles ~304 kB (660 and 1010 kB before).
+stay float64 (the data calibration and validation fit); the profiles, the Newton residual
+histories, the plastic strain field and the final mesh (``X``, ``u``: pictures; on the
+campaign v2 band mesh they were 137 of 331 kB of a run) are float32: rounded to nearest,
+relative error <= 2**-24 = 6.0e-8 (measured <= 5.92e-8 on runs to h/R = 0.3); writing
+raises ValueError if a finite value overflows float32. The reader returns them as float64
+arrays holding the stored values; ``cells`` are int32. Arrays above ``COMPRESS_ABOVE``
+bytes are gzip(4)+shuffle compressed. A run to h/R = 0.3 (E/sigma_y = 200, default mesh)
+took ~257 kB with float64 X and u, with 4 unloading cycles ~304 kB (660 and 1010 kB
+before any of this).
 
 Units are consistent: lengths in the unit of the radius, stresses in the unit
 of E, forces = stress × length², energies = force × length.
@@ -631,14 +631,14 @@ def write_run_group(parent: h5py.Group, name: str, result: RunResult,
 def _write_mesh(g: h5py.Group, final: dict) -> None:
     """The final state: reference nodes, displacement, cells and plastic strain."""
     mesh = g.create_group("mesh")
-    cells = np.asarray(final["cells"], dtype=np.int64)
+    cells = np.asarray(final["cells"], dtype=np.int32)
     corners = cells.shape[1] if cells.ndim == 2 else 0
     mesh.attrs["cell_type"] = CELL_TYPES.get(corners, "unknown")
     mesh.attrs["node_order"] = NODE_ORDER.get(corners, "unknown")
-    _dataset(mesh, "X", np.asarray(final["X"], dtype=float), units="length",
-             description="reference coordinates (r, z), pole at the origin")
-    _dataset(mesh, "u", np.asarray(final["u"], dtype=float), units="length",
-             description="final displacement, interleaved (u_r, u_z) per node")
+    _dataset(mesh, "X", _compact(final["X"], "final['X']"), units="length",
+             description="reference coordinates (r, z), pole at the origin (float32)")
+    _dataset(mesh, "u", _compact(final["u"], "final['u']"), units="length",
+             description="final displacement, interleaved (u_r, u_z) per node (float32)")
     _dataset(mesh, "cells", cells, units="index", description="node indices per element")
     _dataset(mesh, "eps_p", _compact(final["eps_p"], "final['eps_p']"), units="1",
              description="final equivalent plastic strain at the 2x2 Gauss points (float32)")
