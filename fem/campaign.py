@@ -323,7 +323,8 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
             stream = _inline(todo, runner)
         else:  # workers report their runs' h/h_max to a folder next to the database
             folder = db_path.parent / f".{db_path.name}.progress"
-            folder.mkdir(exist_ok=True)
+            shutil.rmtree(folder, ignore_errors=True)  # a killed campaign's reports are stale
+            folder.mkdir()
             stream = _local(todo, runner, min(workers, len(todo)), folder,
                             _running_reporter(bar, folder))
         try:
