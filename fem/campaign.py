@@ -191,11 +191,20 @@ def _state(db: Database | None, key: str) -> str:
     return db.record(key).status if db is not None and key in db else "missing"
 
 
+def expected_cost(case: Case) -> float:
+    """A rough relative wall time: increments grow with E/σY (plastic onset at smaller h),
+    two bodies cost about 3x and penalty pairs 10x a one-body run."""
+    p = case.params
+    factor = 1.0 if case.scene != "two_body" else (10.0 if case.inputs["options"].get("penalty") else 3.0)
+    return factor * p["E_over_sigma_y"] ** 0.5 * p.get("mesh_density", 1.0) ** 2
+
+
 def plan(cases: list[Case], db: Database | None, retry_failed: bool = False,
          retry_stopped: bool = False) -> list[Case]:
-    """The cases to run: missing ones, plus failed / stopped ones when asked to retry."""
+    """The cases to run: missing ones, plus failed / stopped ones when asked to retry, the
+    cheapest first (:func:`expected_cost`), so an interrupted campaign has done the most runs."""
     rerun = {"missing"} | ({"failed"} if retry_failed else set()) | ({"stopped"} if retry_stopped else set())
-    return [c for c in cases if _state(db, c.key) in rerun]
+    return sorted((c for c in cases if _state(db, c.key) in rerun), key=expected_cost)
 
 
 def superseded(campaign: Campaign, db: Database | None) -> list[Record]:

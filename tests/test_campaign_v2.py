@@ -119,3 +119,13 @@ def test_shipped_v2_design():
     assert any(x.params["K_over_sigma_y"] == 5 for x in val)
     E = [x.params["E_over_sigma_y"] for x in cal]
     assert min(E) == 10 and max(E) == 10000
+
+
+def test_plan_runs_the_cheapest_cases_first():
+    from spherecontact.fem.campaign import plan
+
+    cases = parse_campaign(HEAD + '[[s]]\nscene = "flat"\nE_over_sigma_y = [10000, 10, 300]\n'
+                                  '[[s]]\nscene = "two_body"\nE_over_sigma_y = 30\n'
+                                  'E2_over_E1 = 3\noptions = { penalty = 100 }\n').cases
+    order = [c.name.split("-")[0] + "-" + c.name.split("-")[2] for c in plan(list(cases), None)]
+    assert order == ["flat-E10", "flat-E300", "two-E30", "flat-E10000"]  # cost 3, 17, 55, 100
