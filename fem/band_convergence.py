@@ -20,20 +20,13 @@ from pathlib import Path
 import numpy as np
 
 from ..model.material import Material
-from ..validation.metrics import scatter
+from ..validation.metrics import local_fit_at, scatter
 from .io import run_indentation
 
 CHECK_H = (0.05, 0.1, 0.3)
 MESHES = {"band 0.03, density 1": (0.03, 1.0), "band 0.03, density 2": (0.03, 2.0),
           "default, density 1": (0.0, 1.0)}
 WINDOW = 11
-
-
-def local_fit(h: np.ndarray, y: np.ndarray, at: float, window: int = WINDOW) -> float:
-    """y at ``at`` on the quadratic in ln h through the ``window`` increments nearest to it."""
-    idx = np.argsort(np.abs(np.log(h) - math.log(at)))[:window]
-    c = np.polyfit(np.log(h[idx]), np.log(y[idx]), 2)
-    return float(np.exp(np.polyval(c, math.log(at))))
 
 
 def one(label: str) -> dict:
@@ -48,8 +41,8 @@ def one(label: str) -> dict:
     for x in CHECK_H:
         out[f"F@{x:g}"] = float(np.exp(np.interp(math.log(x), np.log(h), np.log(F))))
         out[f"a@{x:g}"] = float(np.exp(np.interp(math.log(x), np.log(h), np.log(a))))
-        out[f"F_fit@{x:g}"] = local_fit(h, F, x)
-        out[f"a_fit@{x:g}"] = local_fit(h, a, x)
+        out[f"F_fit@{x:g}"] = local_fit_at(h, F, x, WINDOW)
+        out[f"a_fit@{x:g}"] = local_fit_at(h, a, x, WINDOW)
     return out
 
 

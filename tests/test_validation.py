@@ -309,6 +309,19 @@ def test_scatter_measures_noise_not_curvature():
     assert np.max(np.abs(smooth_loglog(h, wiggle)[10:-10] / smooth[10:-10] - 1)) < 0.002
 
 
+def test_local_fit_reads_through_the_steps_that_the_point_value_sits_on():
+    from spherecontact.validation.metrics import local_fit_at
+
+    h = np.geomspace(1e-3, 0.3, 200)
+    smooth = 2 * h**1.3 * (1 + h)
+    steps = smooth * (1 + 0.02 * (np.arange(h.size) % 4 == 0))  # +2 % on every 4th increment
+    at = float(h[100])  # an increment on a step
+    assert steps[100] / smooth[100] - 1 == pytest.approx(0.02)
+    assert abs(local_fit_at(h, steps, at) / (2 * at**1.3 * (1 + at)) - 1.005) < 0.002  # the mean offset
+    with pytest.raises(ValueError, match="window = 11"):
+        local_fit_at(h[:5], smooth[:5], at)
+
+
 def test_study_runs_outside_the_database(tmp_path):
     """Verification JSON (inputs from the verification plan) and study files (inputs stored)."""
     import json

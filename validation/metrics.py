@@ -143,6 +143,21 @@ def smooth_loglog(h, y, window: int = 11) -> np.ndarray:
     return out
 
 
+def local_fit_at(h, y, at: float, window: int = 11) -> float:
+    """y at approach ``at`` read on the least-squares quadratic in ln h (of ln y) through the
+    ``window`` increments nearest to it: the curve's value with the increment-to-increment
+    scatter (:func:`scatter`) averaged out, for comparing two FE runs at one approach."""
+    h = np.asarray(h, dtype=float)
+    y = np.asarray(y, dtype=float)
+    ok = (h > 0) & (y > 0)
+    h, y = h[ok], y[ok]
+    if h.size < window:
+        raise ValueError(f"local_fit_at needs at least window = {window} points with h, y > 0, got {h.size}")
+    idx = np.argsort(np.abs(np.log(h) - math.log(at)))[:window]
+    c = np.polyfit(np.log(h[idx]) - math.log(at), np.log(y[idx]), 2)
+    return float(np.exp(c[-1]))
+
+
 def scatter(h, y, mask=None, window: int = 11) -> float:
     """Increment-to-increment scatter of a positive curve: max |ln y − smooth(ln y)|.
 
