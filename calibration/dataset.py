@@ -136,8 +136,9 @@ class RunCurve:
 
 def run_curve(key: str, run, per_decade: int = PER_DECADE,
               a_min_elements: float = A_MIN_ELEMENTS) -> RunCurve | None:
-    """Resample one run (a ``spherecontact.fem.io.Run`` or anything with ``h, F, a,
-    inputs, material()``); None if no increment is resolved (a < a_min).
+    """Resample one run's loading curve (a ``spherecontact.fem.io.Run`` or anything with
+    ``h, F, a, inputs, material()`` and optionally a ``loading`` mask); None if no
+    increment is resolved (a < a_min).
     """
     inp = run.inputs
     R = float(inp["radius"])
@@ -146,6 +147,9 @@ def run_curve(key: str, run, per_decade: int = PER_DECADE,
     rho = relative_radius(R, Ri)
     h, F, a = (np.asarray(v, dtype=float) for v in (run.h, run.F, run.a))
     ok = (h > 0) & (F > 0) & (a > 0) & np.isfinite(h + F + a)
+    loading = getattr(run, "loading", None)  # runs with unloading cycles: the loading curve only
+    if loading is not None:
+        ok &= np.asarray(loading, dtype=bool)
     h, F, a = h[ok], F[ok], a[ok]
     order = np.argsort(h, kind="stable")
     h, F, a = h[order], F[order], a[order]

@@ -221,7 +221,7 @@ def load_runs(db_path, include_stopped: bool = True):
     left_out = [{"key": r.key, "case": r.case, "status": r.status, "reason": r.reason}
                 for r in db.records(set="calibration") if r.key not in used]
     dates = sorted(str(run.provenance.get("date_utc", "")) for _, run in pairs)
-    partial = [{"key": r.key, "case": r.case, "h_last": float(run.h[-1]), "reason": r.reason}
+    partial = [{"key": r.key, "case": r.case, "h_last": float(run.h.max()), "reason": r.reason}
                for r, run in pairs if r.status == "stopped"]
     h = hashlib.sha256()  # the data the fit sees: keys, statuses and the curves h, F, a
     for r, run in sorted(pairs, key=lambda p: p[0].key):

@@ -750,6 +750,13 @@ class Run:
         return self.curves["a"]
 
     @property
+    def loading(self) -> np.ndarray:
+        """Mask of the loading increments (``branch`` 0: the monotone loading curve, without
+        unloading and reloading below the previous maximum); all True without cycles."""
+        branch = self.curves.get("branch")
+        return np.ones(self.n_increments, dtype=bool) if branch is None else np.asarray(branch) == 0
+
+    @property
     def converged(self) -> bool:
         """True when the run reached h_max."""
         return self.status == "converged"

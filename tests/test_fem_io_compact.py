@@ -1,5 +1,7 @@
 """Compact run files: profiles at selected increments in float32, old layout still readable."""
 
+from types import SimpleNamespace
+
 import h5py
 import numpy as np
 import pytest
@@ -184,3 +186,23 @@ def test_monkeypatched_row_limit_is_honoured(cyclic, tmp_path, monkeypatch):
     run = read_run(write_run(tmp_path / "run.h5", cyclic))
     assert 14 <= run.profile_increment.size <= 16  # 10 fixed rows + up to 6 spread
     assert _branch_sides(cyclic.curves["branch"]) <= set(run.profile_increment.tolist())
+
+
+# ---------------------------------------------------------------------------- loading curve
+def test_calibration_and_validation_read_the_loading_curve_of_a_cyclic_run(cyclic, stored):
+    """Unloading and reloading increments must not enter the fitted or validated F(h)."""
+    from spherecontact.calibration.dataset import run_curve
+    from spherecontact.validation.cases import Case
+
+    _, run = stored
+    load = run.loading
+    assert load.sum() < run.h.size and np.all(np.diff(run.h[load]) > 0)  # monotone, cycles left out
+    curve = run_curve("k", run)
+    monotone = SimpleNamespace(h=run.h[load], F=run.F[load], a=run.a[load], inputs=run.inputs,
+                               material=run.material)  # the same run without its cycles
+    np.testing.assert_array_equal(curve.F, run_curve("k", monotone).F)
+    with_cycles = SimpleNamespace(**{**vars(monotone), "h": run.h, "F": run.F, "a": run.a})
+    assert not np.array_equal(run_curve("k", with_cycles).F, curve.F)  # cycles would change it
+    case = Case(key="k", set="validation", name="n", params={}, inputs=run.inputs, curves=dict(run.curves))
+    np.testing.assert_array_equal(case.F, run.F[load])
+    assert case.raw_curve("F").size == run.h.size

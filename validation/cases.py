@@ -72,19 +72,33 @@ class Case:
         return self.name or self.key
 
     @property
+    def loading(self) -> np.ndarray:
+        """Mask of the loading increments (``branch`` 0); all True for runs without cycles."""
+        branch = self.curves.get("branch")
+        n = np.size(self.curves["h"])
+        return np.ones(n, dtype=bool) if branch is None else np.asarray(branch) == 0
+
+    @property
     def h(self) -> np.ndarray:
-        return np.asarray(self.curves["h"], dtype=float)
+        """Approach on the loading curve (unloading and reloading increments left out)."""
+        return self.curve("h")
 
     @property
     def F(self) -> np.ndarray:
-        return np.asarray(self.curves["F"], dtype=float)
+        return self.curve("F")
 
     @property
     def a(self) -> np.ndarray:
-        return np.asarray(self.curves["a"], dtype=float)
+        return self.curve("a")
 
     def curve(self, name: str) -> np.ndarray | None:
-        """A recorded curve, or None when the run does not hold it."""
+        """A recorded curve on the loading increments, or None when the run does not hold it
+        (``raw_curve``: every increment, loading, unloading and reloading)."""
+        c = self.raw_curve(name)
+        return None if c is None else c[self.loading]
+
+    def raw_curve(self, name: str) -> np.ndarray | None:
+        """A recorded curve at every increment in the order computed, or None."""
         c = self.curves.get(name)
         return None if c is None else np.asarray(c, dtype=float)
 
