@@ -31,8 +31,17 @@ from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segment_penalty import SegmentPenalty
 
-#: nodal-force roundoff of the stress update, in units of E R² (see ``_newton``)
-ROUNDOFF = 1e-16
+#: nodal-force roundoff of the stress update, in units of M R² with M = max(E, 3κ) the
+#: stiffest elastic modulus (see ``_newton``; measured ~2e-14 M R² after a plastic cycle at
+#: ν = 0.45, where 3κ = 10 E)
+ROUNDOFF = 1e-15
+
+
+def stiffest_modulus(material) -> float:
+    """max(E, 3κ): the modulus the roundoff of the stresses scales with (3κ for ν → 1/2)."""
+    return max(material.E, 3.0 * material.bulk_modulus)
+#: an unloading branch whose increment fails below this fraction of F_max ends there
+UNLOAD_TAIL = 1e-3
 
 
 class IncrementFailed(RuntimeError):
@@ -413,6 +422,8 @@ class CycleLegs:
         Increments: about ``options.unload_increments`` over the elastic recovery estimated from
         Sneddon's initial stiffness 2E*a, Δh ≈ 1.5 F_max/(2E*a). The last increment lands on
         h_res, extrapolated from the last two points with F > 0 (:func:`residual_approach`).
+        When an increment fails once F ≤ ``UNLOAD_TAIL`` F_max (Newton at the roundoff floor of
+        a nearly unloaded body), the branch ends there with h_res extrapolated the same way.
         """
         hist, R = self._hist, self._length
         i_peak = len(hist.h) - 1
@@ -422,7 +433,7 @@ class CycleLegs:
         run.dh_cycle = max(min(recovery, run.h) / self.options.unload_increments, self.options.dh_min * R * 4)
         run.u_prev = None
         dh = run.dh_cycle
-        lost, h_lost = False, 0.0
+        lost, h_lost, tail = False, 0.0, False
         while True:
             if self._out_of_time(run):
                 return None
@@ -437,6 +448,9 @@ class CycleLegs:
                 h_new, lost = 0.0, True
             solved = self._solve(run, h_new)
             if isinstance(solved, Exception):
+                if run.F <= UNLOAD_TAIL * F_peak and len(hist.h) - i_peak >= 3:
+                    tail = True  # the force has all but vanished: h_res extrapolated below
+                    break
                 if not self._cut_back(run, dh, solved):
                     return None
                 dh *= 0.5
@@ -451,7 +465,11 @@ class CycleLegs:
         base = run.cycle_base
         i_end = len(hist.h) - 1
         xs = self._residual_surface(run.u)
-        cycle = {"h_max": h_peak, "F_max": F_peak, "a_max": hist.a[i_peak], "h_res": run.h,
+        h_res = run.h
+        if tail:
+            h_ext = residual_approach(np.array(hist.h[i_peak:]), np.array(hist.F[i_peak:]))
+            h_res = min(max(h_ext, 0.0), run.h)
+        cycle = {"h_max": h_peak, "F_max": F_peak, "a_max": hist.a[i_peak], "h_res": h_res,
                  "pole_radius": pole_radius(xs[0], xs[1], 0.5 * hist.a[i_peak]),
                  "work_in": hist.work_external[i_peak] - base["work"],
                  "work_returned": hist.work_external[i_peak] - hist.work_external[i_end],
@@ -636,8 +654,9 @@ class IndentationSolver(CycleLegs):
             ref = max(np.abs(r[fixed]).max(), 1e-300)
             res = float(np.abs(r[free]).max()) / ref
             # roundoff floor: F = I + ∇u carries strains next to 1, so stresses carry an
-            # absolute error ~1e-16 E and nodal forces ~1e-16 E R² (matters at h ≲ 1e-5 R)
-            floor = ROUNDOFF * mat.E * R**2 / ref
+            # absolute error ~1e-16 M per operation and nodal forces ~1e-15 M R² (matters at
+            # h ≲ 1e-5 R, and near zero force on unloading)
+            floor = ROUNDOFF * stiffest_modulus(mat) * R**2 / ref
             res_hist.append(res)
             t3 = time.perf_counter()
             self.timers["constitutive"] += t1 - t0

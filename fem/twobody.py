@@ -53,6 +53,7 @@ from .solver import (
     finish_curves,
     new_active_log,
     plastic_dissipation,
+    stiffest_modulus,
     update_active_set,
 )
 
@@ -311,7 +312,7 @@ class TwoBodySolver(CycleLegs):
             r = f - Gt_lam
             ref = max(np.abs(r[~free]).max(), np.abs(Gt_lam).max(), 1e-300)
             res = float(np.abs(r[free]).max()) / ref
-            floor = ROUNDOFF * max(b.material.E for b in self.bodies) * self.R**2 / ref
+            floor = ROUNDOFF * max(stiffest_modulus(b.material) for b in self.bodies) * self.R**2 / ref
             gap_err = float(np.abs(kin.gap[active]).max(initial=0.0))
             log["res"].append(res)
             if not np.isfinite(res) or res > 1e6:
@@ -417,7 +418,7 @@ class TwoBodySolver(CycleLegs):
             prev = pens
             ref = max(np.abs(r[~free]).max(), 1e-300)
             res = float(np.abs(r[free]).max()) / ref
-            floor = ROUNDOFF * max(b.material.E for b in self.bodies) * self.R**2 / ref
+            floor = ROUNDOFF * max(stiffest_modulus(b.material) for b in self.bodies) * self.R**2 / ref
             log["res"].append(res)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")

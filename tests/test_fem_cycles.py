@@ -126,3 +126,41 @@ def test_cli_rejects_a_bad_schedule_before_any_work(tmp_path, capsys):
                  "--out", str(tmp_path / "x.h5")])
     assert code == 2 and "unload_at" in capsys.readouterr().err
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_unloading_tail_that_fails_ends_the_branch_with_an_extrapolated_residual_approach(
+        plastic_run, monkeypatch):
+    """Near zero force Newton can sit at the roundoff floor; below UNLOAD_TAIL F_max the branch
+    ends there (h_res extrapolated) instead of stopping the whole run. Simulated here: every
+    unloading step (h decreasing) from F < 1 % F_max fails, with UNLOAD_TAIL raised to 2 %."""
+    from spherecontact.fem import solver as fs
+
+    monkeypatch.setattr(fs, "UNLOAD_TAIL", 0.02)
+    solver = IndentationSolver(EPP, 1.0, density=0.5)
+    solve = solver._solve
+
+    def failing_near_zero(run, h_new, *args, **kw):
+        if h_new < run.h and solver._hist.branch[-1] == UNLOAD and run.F < 1e-2 * run_peak(solver):
+            return fs.IncrementFailed("roundoff floor (simulated)")
+        return solve(run, h_new, *args, **kw)
+
+    def run_peak(s):
+        b = np.array(s._hist.branch)
+        return np.array(s._hist.F)[np.flatnonzero(b != UNLOAD)[-1]]
+
+    solver._solve = failing_near_zero
+    res = solver.run(0.012, unload_at=[0.006, 0.01])
+    assert res.status == "converged", res.reason
+    got, ref = res.cycles["h_res"], plastic_run.cycles["h_res"]
+    assert got.size == ref.size == 2
+    np.testing.assert_allclose(got, ref, rtol=0.02)  # extrapolated from F < 1 % F_max
+    ends = res.cycles["increment_end"].astype(int)
+    assert np.any(res.F[ends] > 0)  # a branch ended on its tail, before a solved state at F = 0
+    assert np.all(res.cycles["h_res"] <= res.h[ends] + 1e-15)
+    monkeypatch.setattr(fs, "UNLOAD_TAIL", 1e-5)  # without the tail rule the run stops
+    stopped = IndentationSolver(EPP, 1.0, density=0.5)
+    inner = stopped._solve
+    stopped._solve = lambda run, h, *a, **k: (
+        fs.IncrementFailed("simulated") if h < run.h and stopped._hist.branch[-1] == UNLOAD
+        and run.F < 1e-2 * run_peak(stopped) else inner(run, h, *a, **k))
+    assert stopped.run(0.012, unload_at=[0.006, 0.01]).status == "stopped"
