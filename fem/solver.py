@@ -40,9 +40,6 @@ ROUNDOFF = 1e-15
 def stiffest_modulus(material) -> float:
     """max(E, 3κ): the modulus the roundoff of the stresses scales with (3κ for ν → 1/2)."""
     return max(material.E, 3.0 * material.bulk_modulus)
-#: Newton accepts a stalled residual from iteration STALL_AFTER on when the last STALL_WINDOW
-#: residuals all lie within STALL_FACTOR of the tolerance (counted: ``stalled_increments``)
-STALL_AFTER, STALL_WINDOW, STALL_FACTOR = 15, 5, 3.0
 #: an unloading branch whose increment fails below this fraction of F_max ends there
 UNLOAD_TAIL = 1e-3
 
@@ -667,14 +664,7 @@ class IndentationSolver(CycleLegs):
             self.timers["contact"] += t3 - t2
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            # stalled: late in the iterations every one of the last STALL_WINDOW residuals lies
-            # within STALL_FACTOR of the tolerance (seen after unloading cycles with heavy
-            # hardening: 1.0-1.9e-8 however small the increment); accepted and counted
-            stalled = (it >= STALL_AFTER and len(res_hist) >= STALL_WINDOW
-                       and max(res_hist[-STALL_WINDOW:]) <= STALL_FACTOR * max(opt.tol, floor))
-            converged = res <= max(opt.tol, floor) or stalled
-            if not changed and converged and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
-                self.stalled += res > max(opt.tol, floor)
+            if not changed and res <= max(opt.tol, floor) and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
                 return (u, upd, active, it, log["changes"], res_hist, f, gap, np.where(active, lam, 0.0),
                         normal)
             K = disc.matrix(data)
@@ -855,7 +845,6 @@ class IndentationSolver(CycleLegs):
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(opt.linear_solver)
         self.rejected = []
-        self.stalled = 0
         hist = History()
         self._hist, self._progress = hist, progress
         targets = None
@@ -881,8 +870,7 @@ class IndentationSolver(CycleLegs):
         prof_g = np.array(hist.profile_g).reshape(-1, nsurf)
         timings = {"wall_s": wall, "setup_s": self.t_setup, **self._timer_split(),
                    "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum()),
-                   "rejected_increments": len(self.rejected), "stalled_increments": self.stalled,
-                   **{f"linear_{k}": v for k, v in
+                   "rejected_increments": len(self.rejected), **{f"linear_{k}": v for k, v in
                                                                  self.linear.stats.items()}}
         final = {"X": self.X, "u": u, "cells": self.disc.basis.element_dofs.T.copy(),
                  "eps_p": state.eps_p.reshape(self.disc.n_elements, self.disc.n_qp)}
