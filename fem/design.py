@@ -35,6 +35,7 @@ from scipy.stats import qmc
 from ..data import input_key
 from ..model.material import Material
 from .assembly import ELEMENTS
+from .io import material_from_description
 from .mesh import DENSITY_RANGE, EDGE_BAND_MAX
 from .solver import SolverOptions
 
@@ -168,21 +169,15 @@ class Case:
     def run_kwargs(self) -> dict:
         """Keyword arguments of ``fem.io.run_indentation`` for this case."""
         i = self.inputs
-        kw = {"material": _material(i["material"]), "radius": i["radius"], "h_max": i["h_max"],
-              "density": i["mesh_density"], "element": i["element"],
+        kw = {"material": material_from_description(i["material"]), "radius": i["radius"],
+              "h_max": i["h_max"], "density": i["mesh_density"], "element": i["element"],
               "options": SolverOptions(**i["options"], max_wall_s=self.max_wall_s),
               "edge_band": i.get("edge_band", 0.0), "unload_at": i.get("unload_at")}
         if self.scene == "two_body":
-            kw.update(radius2=i["radius2"], material2=_material(i["material2"]))
+            kw.update(radius2=i["radius2"], material2=material_from_description(i["material2"]))
         else:
             kw["indenter_radius"] = i["indenter_radius"]
         return kw
-
-
-def _material(d: dict) -> Material:
-    if "eps_table" in d:
-        return Material.from_table(d["E"], d["nu"], d["eps_table"], d["sigma_table"])
-    return Material(E=d["E"], nu=d["nu"], sigma_y=d["sigma_y"], K=d["K"], n=d["n"])
 
 
 @dataclass(frozen=True)
@@ -295,7 +290,7 @@ def _check_curves(doc: dict) -> dict:
 
 
 def _check_cycles(value, where: str) -> tuple:
-    """``cycles``: increasing approaches in (0, 1], in the unit of h_max."""
+    """``cycles``: increasing approaches in (0, 0.8], in the unit of h_max."""
     if not isinstance(value, list) or not value or not all(
             isinstance(v, int | float) and not isinstance(v, bool) for v in value):
         raise ValueError(f"{where}: cycles must be a non-empty list of approaches, got {value!r}")
@@ -400,7 +395,7 @@ def _sample(entry: dict, where: str) -> list[dict]:
     if spec is None:
         if ranged:
             raise ValueError(f"{where}: parameter {next(iter(ranged))} is a range but the entry has "
-                             "no sample = {{method, n, seed}} table")
+                             "no sample = {method, n, seed} table")
         return [{}]
     if not isinstance(spec, dict) or set(spec) != {"method", "n", "seed"}:
         raise ValueError(f"{where}: sample must be a table {{method, n, seed}}, got {spec!r}")

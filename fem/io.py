@@ -76,7 +76,7 @@ __all__ = [
     "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "SCENES", "Run", "check_inputs", "choose_scene",
     "run_indentation",
     "write_run", "write_run_group", "read_run", "run_from_group", "provenance",
-    "material_from_description", "PROFILE_ROWS", "profile_increments",
+    "material_from_description", "loading_mask", "PROFILE_ROWS", "profile_increments",
 ]
 
 SCHEMA = "spherecontact.fem.run"
@@ -679,6 +679,13 @@ def write_run(path, result: RunResult, extra_provenance: dict | None = None) -> 
 
 
 # ============================================================================ reading
+def loading_mask(curves: dict) -> np.ndarray:
+    """Mask of the loading increments of a run's curves: ``branch`` 0, the monotone loading
+    curve without unloading and reloading below the previous maximum; all True without cycles."""
+    branch = curves.get("branch")
+    return np.ones(np.size(curves["h"]), dtype=bool) if branch is None else np.asarray(branch) == 0
+
+
 def material_from_description(m: dict) -> Material:
     """Inverse of ``Material.describe()``: E = inf is rigid; missing plastic keys are elastic."""
     E, nu = float(m["E"]), float(m.get("nu", 0.3))
@@ -751,10 +758,8 @@ class Run:
 
     @property
     def loading(self) -> np.ndarray:
-        """Mask of the loading increments (``branch`` 0: the monotone loading curve, without
-        unloading and reloading below the previous maximum); all True without cycles."""
-        branch = self.curves.get("branch")
-        return np.ones(self.n_increments, dtype=bool) if branch is None else np.asarray(branch) == 0
+        """Mask of the loading increments (:func:`loading_mask`)."""
+        return loading_mask(self.curves)
 
     @property
     def converged(self) -> bool:

@@ -35,13 +35,13 @@ from .segment_penalty import SegmentPenalty
 #: stiffest elastic modulus (see ``_newton``; measured ~2e-14 M R² after a plastic cycle at
 #: ν = 0.45, where 3κ = 10 E)
 ROUNDOFF = 1e-15
+#: an unloading branch whose increment fails below this fraction of F_max ends there
+UNLOAD_TAIL = 1e-3
 
 
 def stiffest_modulus(material) -> float:
     """max(E, 3κ): the modulus the roundoff of the stresses scales with (3κ for ν → 1/2)."""
     return max(material.E, 3.0 * material.bulk_modulus)
-#: an unloading branch whose increment fails below this fraction of F_max ends there
-UNLOAD_TAIL = 1e-3
 
 
 class IncrementFailed(RuntimeError):
@@ -434,14 +434,17 @@ class CycleLegs:
         run.u_prev = None
         dh = run.dh_cycle
         lost, h_lost, tail = False, 0.0, False
+
+        def extrapolated_h_res() -> float:  # from the branch's last two points with F > 0
+            return residual_approach(np.array(hist.h[i_peak:]), np.array(hist.F[i_peak:]))
+
         while True:
             if self._out_of_time(run):
                 return None
             if not lost:
                 h_new = run.h - dh
             elif len(hist.h) - i_peak >= 2:
-                h_new = min(max(residual_approach(np.array(hist.h[i_peak:]), np.array(hist.F[i_peak:])),
-                                h_lost), run.h)
+                h_new = min(max(extrapolated_h_res(), h_lost), run.h)
             else:
                 h_new = 0.5 * (run.h + h_lost)
             if h_new <= 0.0:
@@ -465,10 +468,7 @@ class CycleLegs:
         base = run.cycle_base
         i_end = len(hist.h) - 1
         xs = self._residual_surface(run.u)
-        h_res = run.h
-        if tail:
-            h_ext = residual_approach(np.array(hist.h[i_peak:]), np.array(hist.F[i_peak:]))
-            h_res = min(max(h_ext, 0.0), run.h)
+        h_res = min(max(extrapolated_h_res(), 0.0), run.h) if tail else run.h
         cycle = {"h_max": h_peak, "F_max": F_peak, "a_max": hist.a[i_peak], "h_res": h_res,
                  "pole_radius": pole_radius(xs[0], xs[1], 0.5 * hist.a[i_peak]),
                  "work_in": hist.work_external[i_peak] - base["work"],

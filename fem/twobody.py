@@ -487,17 +487,17 @@ class TwoBodySolver(CycleLegs):
                         state=[PlasticState.virgin(b.disc.n_elements * b.disc.n_qp) for b in self.bodies],
                         active=np.zeros(self.candidates.size, dtype=bool), dh=opt.dh_first * R)
         run.lam = np.zeros(self.candidates.size)
-        self._rec = {k: [] for k in ("h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max",
-                                     "work_external", "energy_elastic", "dissipation", "iterations",
-                                     "active_changes", "h1", "h2", "interface_curvature", "dissipation_1",
-                                     "dissipation_2", "eps_p_max_1", "eps_p_max_2", "branch")}
-        self._hist = SimpleNamespace(**self._rec)  # the same lists, by attribute
+        self._hist = SimpleNamespace(**{k: [] for k in (
+            "h", "F", "F_support", "a", "a_nodes", "a_ref", "eps_p_max", "work_external",
+            "energy_elastic", "dissipation", "iterations", "active_changes", "h1", "h2",
+            "interface_curvature", "dissipation_1", "dissipation_2", "eps_p_max_1", "eps_p_max_2",
+            "branch")})  # per increment; CycleLegs reads them by attribute
         self._profiles = ([], [], [], [])  # residuals, r, p, gap per increment
         self._progress = progress
         cycles = self._walk(run, h_max, unload)
         residuals, prof_r, prof_p, prof_g = self._profiles
-        result = self._result(self._rec, residuals, prof_r, prof_p, prof_g, run.status, run.reason, run.u,
-                              run.state, h_max, time.perf_counter() - run.t_start)
+        result = self._result(vars(self._hist), residuals, prof_r, prof_p, prof_g, run.status, run.reason,
+                              run.u, run.state, h_max, time.perf_counter() - run.t_start)
         result.cycles = cycles_as_arrays(cycles, self.candidates.size)
         result.inputs["unload_at"] = [float(x) for x in unload]
         return result
@@ -553,7 +553,7 @@ class TwoBodySolver(CycleLegs):
         run.h, run.F, run.a = h_new, F, a_ref
         run.h_top = max(run.h_top, h_new)
         h1, h2 = self._pole_shortening(u, h_new)
-        rec = self._rec
+        rec = vars(self._hist)
         for key, val in (("h", h_new), ("F", F), ("F_support", F_support), ("a", a_sub),
                          ("a_nodes", a_nodes), ("a_ref", a_ref),
                          ("eps_p_max", max(float(st.eps_p.max()) for st in states)),

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.io import material_from_description
+from ..fem.io import loading_mask, material_from_description
 from ..model import Material, Sphere
 
 __all__ = [
@@ -74,9 +74,7 @@ class Case:
     @property
     def loading(self) -> np.ndarray:
         """Mask of the loading increments (``branch`` 0); all True for runs without cycles."""
-        branch = self.curves.get("branch")
-        n = np.size(self.curves["h"])
-        return np.ones(n, dtype=bool) if branch is None else np.asarray(branch) == 0
+        return loading_mask(self.curves)
 
     @property
     def h(self) -> np.ndarray:
