@@ -36,7 +36,7 @@ from dataclasses import dataclass
 from multiprocessing import get_context
 from pathlib import Path
 
-from ..data import Database, Record, append_run, remove_entries, remove_stale_temporaries
+from ..data import Database, Record, append_run, compact, remove_entries, remove_stale_temporaries
 from .design import Campaign, Case, load_campaign
 from .io import provenance, run_indentation
 from .solver import RunResult
@@ -401,6 +401,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--prune", action="store_true",
                    help="remove the database entries no case of the campaign produces (superseded "
                         "inputs or options), print them, and run nothing")
+    p.add_argument("--compact", action="store_true",
+                   help="rewrite the database with one copy of each mesh and the space of replaced "
+                        "runs reclaimed, print the sizes, and run nothing")
     p.add_argument("--dry-run", action="store_true",
                    help="list the cases, their keys and whether they are in the database; run nothing")
     return p
@@ -426,6 +429,10 @@ def main(argv: list[str] | None = None) -> int:
         sets = _sets(campaign, args.set)
         if args.dry_run:
             print(dry_run(campaign, args.db, sets, args.only))
+            return 0
+        if args.compact:
+            before, after = compact(args.db)
+            print(f"{args.db}: {before / 1e6:.2f} MB -> {after / 1e6:.2f} MB")
             return 0
         if args.prune:
             removed = prune(campaign, args.db)

@@ -18,6 +18,8 @@ version 1), so a database can later copy it as one group among many
       mesh/X                  (2, n_nodes) reference coordinates (r, z) (float32)
       mesh/u                  (2 n_nodes,) final displacement, interleaved (u_r, u_z) (float32)
       mesh/cells              (n_el, 8|4) node indices (int32)
+                              (in a database: X and cells are soft links to one copy
+                              per distinct mesh, ``share_mesh``; attr mesh.shared)
       mesh/eps_p              (n_el, n_qp) final equivalent plastic strain at the Gauss points (float32)
       cycles/<name>           (n_cyc,) or (n_cyc, n_surf) per unloading branch (``CYCLES``);
                               present only in runs with unloading cycles
@@ -52,6 +54,7 @@ of E, forces = stress × length², energies = force × length.
 from __future__ import annotations
 
 import datetime as _dt
+import hashlib
 import math
 import os
 import platform
@@ -75,7 +78,8 @@ from .twobody import TwoBodySolver
 __all__ = [
     "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "SCENES", "Run", "check_inputs", "choose_scene",
     "run_indentation",
-    "write_run", "write_run_group", "read_run", "run_from_group", "provenance",
+    "write_run", "write_run_group", "share_mesh", "mesh_digest", "copy_run_group", "read_run",
+    "run_from_group", "provenance",
     "material_from_description", "loading_mask", "PROFILE_ROWS", "profile_increments",
 ]
 
@@ -588,10 +592,12 @@ def _write_profiles(g: h5py.Group, result: RunResult) -> None:
 
 
 def write_run_group(parent: h5py.Group, name: str, result: RunResult,
-                    prov: dict | None = None) -> h5py.Group:
+                    prov: dict | None = None, shared_meshes: h5py.Group | None = None) -> h5py.Group:
     """Write ``result`` as the group ``parent[name]`` (layout in the module docstring).
 
     ``prov`` is the provenance dict (default: :func:`provenance` of ``result``).
+    ``shared_meshes``: a group of the same file holding one copy of each distinct mesh;
+    ``mesh/X`` and ``mesh/cells`` then are soft links into it (:func:`share_mesh`).
     """
     if result.status not in STATUSES:
         raise ValueError(f"status must be one of {STATUSES}, got {result.status!r}")
@@ -619,7 +625,7 @@ def write_run_group(parent: h5py.Group, name: str, result: RunResult,
     _dataset(newton, "offsets", offsets, units="index",
              description="increment k owns residuals[offsets[k]:offsets[k+1]]")
     _write_profiles(g, result)
-    _write_mesh(g, result.final)
+    _write_mesh(g, result.final, shared_meshes)
     if getattr(result, "cycles", None):
         cyc = g.create_group("cycles")
         for cname, values in result.cycles.items():
@@ -628,20 +634,77 @@ def write_run_group(parent: h5py.Group, name: str, result: RunResult,
     return g
 
 
-def _write_mesh(g: h5py.Group, final: dict) -> None:
+def _write_mesh(g: h5py.Group, final: dict, shared: h5py.Group | None = None) -> None:
     """The final state: reference nodes, displacement, cells and plastic strain."""
     mesh = g.create_group("mesh")
     cells = np.asarray(final["cells"], dtype=np.int32)
     corners = cells.shape[1] if cells.ndim == 2 else 0
     mesh.attrs["cell_type"] = CELL_TYPES.get(corners, "unknown")
     mesh.attrs["node_order"] = NODE_ORDER.get(corners, "unknown")
-    _dataset(mesh, "X", _compact(final["X"], "final['X']"), units="length",
-             description="reference coordinates (r, z), pole at the origin (float32)")
+    X = _compact(final["X"], "final['X']")
+    if shared is None:
+        _write_geometry(mesh, X, cells)
+    else:
+        share_mesh(mesh, X, cells, shared)
     _dataset(mesh, "u", _compact(final["u"], "final['u']"), units="length",
              description="final displacement, interleaved (u_r, u_z) per node (float32)")
-    _dataset(mesh, "cells", cells, units="index", description="node indices per element")
     _dataset(mesh, "eps_p", _compact(final["eps_p"], "final['eps_p']"), units="1",
              description="final equivalent plastic strain at the 2x2 Gauss points (float32)")
+
+
+def _write_geometry(group: h5py.Group, X: np.ndarray, cells: np.ndarray) -> None:
+    """The datasets ``X`` (float32) and ``cells`` (int32) of a mesh."""
+    _dataset(group, "X", X, units="length",
+             description="reference coordinates (r, z), pole at the origin (float32)")
+    _dataset(group, "cells", cells, units="index", description="node indices per element")
+
+
+def mesh_digest(X: np.ndarray, cells: np.ndarray) -> str:
+    """SHA-256 (first 16 hex digits) of a mesh's float32 coordinates and int32 cells."""
+    h = hashlib.sha256()
+    for arr in (np.ascontiguousarray(X, dtype=COMPACT), np.ascontiguousarray(cells, dtype=np.int32)):
+        h.update(f"{arr.shape}\0".encode())
+        h.update(arr.tobytes())
+    return h.hexdigest()[:16]
+
+
+def share_mesh(mesh: h5py.Group, X: np.ndarray, cells: np.ndarray, shared: h5py.Group) -> str:
+    """Make ``mesh/X`` and ``mesh/cells`` soft links to ``shared/<digest>/{X,cells}``, written
+    once per distinct mesh (:func:`mesh_digest`); record the digest in ``mesh.attrs["shared"]``.
+
+    Runs of one campaign mostly share a few meshes: on campaign v2, X and cells were 55 of
+    ~355 kB of a run. Readers follow the links (``mesh["X"]`` reads as a dataset).
+    """
+    if mesh.file != shared.file:
+        raise ValueError("shared meshes must be in the file of the run")
+    X = np.asarray(X, dtype=COMPACT)
+    cells = np.asarray(cells, dtype=np.int32)
+    digest = mesh_digest(X, cells)
+    if digest not in shared:
+        _write_geometry(shared.create_group(digest), X, cells)
+    for name in ("X", "cells"):
+        mesh[name] = h5py.SoftLink(f"{shared[digest].name}/{name}")
+    mesh.attrs["shared"] = digest
+    return digest
+
+
+def copy_run_group(src: h5py.Group, parent: h5py.Group, name: str,
+                   shared_meshes: h5py.Group | None = None) -> h5py.Group:
+    """Copy the run group ``src`` (any file) to ``parent[name]``; with ``shared_meshes`` its
+    ``X`` and ``cells`` go there (:func:`share_mesh`) instead of into the copy."""
+    g = parent.create_group(name)
+    g.attrs.update(dict(src.attrs))
+    for child in src:
+        if child != "mesh" or shared_meshes is None:
+            src.copy(src[child], g, name=child, expand_soft=True)
+            continue
+        mesh = g.create_group("mesh")
+        mesh.attrs.update({k: v for k, v in src["mesh"].attrs.items() if k != "shared"})
+        share_mesh(mesh, src["mesh/X"][()], src["mesh/cells"][()], shared_meshes)
+        for field_name in src["mesh"]:
+            if field_name not in ("X", "cells"):
+                src.copy(src["mesh"][field_name], mesh, name=field_name)
+    return g
 
 
 def _temporary_sibling(path: Path) -> Path:

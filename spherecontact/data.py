@@ -10,6 +10,8 @@ The one reader and writer of the file (layout and units in ``data/README.md``)::
                                     campaign.inputs (JSON, the inputs the key hashes)
       failed/<key>          attrs set, case, reason, traceback, inputs (JSON),
                                   params (JSON), wall_s, date_utc; no data
+      meshes/<digest>/X, cells  one copy of each distinct mesh; the runs' mesh/X and
+                            mesh/cells are soft links to it (fem.io.share_mesh)
 
 ``key`` = :func:`input_key` of the run's requested inputs. A run that reached
 h_max has status ``converged``, one that stopped early (wall-time limit,
@@ -46,6 +48,7 @@ from .fem.io import (
     _python_value,
     _temporary_sibling,
     _unflatten,
+    copy_run_group,
     provenance,
     run_from_group,
     write_run_group,
@@ -53,7 +56,7 @@ from .fem.io import (
 from .fem.solver import RunResult
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "STATUSES", "Record", "Database", "input_key", "append_run",
-           "remove_entries", "remove_stale_temporaries"]
+           "remove_entries", "remove_stale_temporaries", "compact"]
 
 SCHEMA = "spherecontact.database"
 SCHEMA_VERSION = 1
@@ -61,6 +64,7 @@ SCHEMA_VERSION = 1
 STATUSES = ("converged", "stopped", "failed")
 RUNS = "runs"
 FAILED = "failed"
+MESHES = "meshes"
 KEY_LENGTH = 16
 _KEY_RE = re.compile(rf"^[0-9a-f]{{{KEY_LENGTH}}}$")
 #: attributes the database adds to a run group (JSON values where noted)
@@ -352,11 +356,22 @@ class Database:
         return self._content_hash
 
 
+def _dataset_paths(g: h5py.Group, prefix: str = "") -> list[str]:
+    """Paths of every dataset under ``g``, soft links followed (shared meshes count)."""
+    out = []
+    for name in g:
+        obj = g[name]
+        if isinstance(obj, h5py.Group):
+            out += _dataset_paths(obj, f"{prefix}{name}/")
+        elif isinstance(obj, h5py.Dataset):
+            out.append(f"{prefix}{name}")
+    return out
+
+
 def _hash_group(h, g: h5py.Group) -> None:
-    """Feed every dataset of ``g`` (sorted paths: name, dtype, shape, bytes) into ``h``."""
-    names: list[str] = []
-    g.visititems(lambda name, obj: names.append(name) if isinstance(obj, h5py.Dataset) else None)
-    for name in sorted(names):
+    """Feed every dataset of ``g`` (sorted paths: name, dtype, shape, bytes) into ``h``;
+    a mesh shared by soft links hashes as if the run held it."""
+    for name in sorted(_dataset_paths(g)):
         arr = np.ascontiguousarray(g[name][()])
         h.update(f"{name}\0{arr.dtype.str}\0{arr.shape}\0".encode())
         h.update(arr.tobytes())
@@ -417,7 +432,7 @@ def _write_entry(f: h5py.File, record: Record, result: RunResult | None, prov: d
                         "wall_s": np.float64(record.wall_s), "date_utc": _utc_now()})
         return
     g = write_run_group(f.require_group(RUNS), record.key, result,
-                        provenance(result) if prov is None else prov)
+                        provenance(result) if prov is None else prov, f.require_group(MESHES))
     g.attrs[SET_ATTR] = record.set
     g.attrs[CASE_ATTR] = record.case
     g.attrs[PARAMS_ATTR] = _to_json(record.params)
@@ -425,18 +440,41 @@ def _write_entry(f: h5py.File, record: Record, result: RunResult | None, prov: d
 
 
 def _copy_without(src: Path, dst: Path, drop) -> None:
-    """Copy the database ``src`` to ``dst`` leaving out the group(s) ``drop`` (space reclaimed)."""
+    """Copy the database ``src`` to ``dst`` leaving out the group(s) ``drop`` (space reclaimed).
+
+    Runs are copied with their meshes shared (``fem.io.copy_run_group``): one copy of each
+    mesh a kept run uses, whether ``src`` shared them or not.
+    """
     drop = {drop} if isinstance(drop, str) else set(drop)
     with h5py.File(src, "r") as fs, h5py.File(dst, "w") as fd:
         fd.attrs.update(dict(fs.attrs))
         for top in fs:
+            if top == MESHES:
+                continue  # rebuilt from the runs kept
             if not isinstance(fs[top], h5py.Group):
                 fs.copy(fs[top], fd, name=top)
                 continue
             fd.create_group(top).attrs.update(dict(fs[top].attrs))
             for name in fs[top]:
-                if f"{top}/{name}" not in drop:
+                if f"{top}/{name}" in drop:
+                    continue
+                if top == RUNS:
+                    copy_run_group(fs[top][name], fd[top], name, fd.require_group(MESHES))
+                else:
                     fs.copy(fs[top][name], fd[top], name=name)
+
+
+def compact(path) -> tuple[int, int]:
+    """Rewrite the database ``path`` with shared meshes and the space of removed or replaced
+    entries reclaimed; return its size in bytes (before, after). Crash-safe like
+    :func:`append_run`; the entries and their data are unchanged."""
+    path = Path(path)
+    with _directory_lock(path.parent):
+        Database(path)  # validated before it is rewritten
+        before = path.stat().st_size
+        with _replacing(path) as tmp:
+            _copy_without(path, tmp, [])
+    return before, path.stat().st_size
 
 
 def remove_entries(path, keys) -> list[Record]:

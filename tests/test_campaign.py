@@ -216,6 +216,9 @@ def test_superseded_entries_are_listed_and_pruned(tmp_path, capsys):
                     fc.Outcome(case.key, "failed", "RuntimeError: no solver", 0.0))
     assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--prune"]) == 0
     assert "0 superseded entries removed" in capsys.readouterr().out
+    h = Database(db_path).content_hash
+    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--compact"]) == 0
+    assert f"{db_path}: " in capsys.readouterr().out and Database(db_path).content_hash == h
     # new solver options give both cases new keys: the old run and the old failure are superseded
     toml.write_text(tiny(body).replace("dh_max = 0.005", "dh_max = 0.004"))
     changed = load_campaign(toml)

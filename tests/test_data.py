@@ -145,6 +145,69 @@ def test_content_hash_is_deterministic_and_tracks_content(tmp_path, db_path, res
     assert Database(first).content_hash != h
 
 
+def test_runs_share_one_copy_of_each_mesh(db_path, results):
+    """Three runs on one mesh: one copy under meshes/, read back through the links."""
+    a, b, c = results
+    with h5py.File(db_path, "r") as f:
+        assert list(f[data.MESHES]) == [a_digest := f[data.RUNS][input_key(inputs())]["mesh"].attrs["shared"]]
+        for g in f[data.RUNS].values():
+            assert isinstance(g["mesh"].get("X", getlink=True), h5py.SoftLink)
+            assert g["mesh"].attrs["shared"] == a_digest
+    db = Database(db_path)
+    for inp, res in ((inputs(), a), (inputs(E=200.0), b)):
+        run = db.run(input_key(inp))
+        assert np.array_equal(run.mesh["X"], res.final["X"].astype(np.float32))
+        assert np.array_equal(run.mesh["cells"], res.final["cells"])
+
+
+def _unshared_copy(src, dst):
+    """The database ``src`` written the way it was before meshes were shared."""
+    with h5py.File(src, "r") as fs, h5py.File(dst, "w") as fd:
+        fd.attrs.update(dict(fs.attrs))
+        fs.copy(fs[data.FAILED], fd, name=data.FAILED)
+        runs = fd.create_group(data.RUNS)
+        for key in fs[data.RUNS]:  # one copy each: separate X and cells per run
+            fs.copy(fs[data.RUNS][key], runs, name=key, expand_soft=True)
+
+
+def _stored_meshes(path) -> int:
+    """How many coordinate arrays the file stores (each object once, links not followed)."""
+    names = []
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: names.append(name) if name.endswith("/X") else None)
+    return len(names)
+
+
+def test_compact_shares_meshes_and_keeps_content(tmp_path, db_path):
+    old = tmp_path / "old.h5"
+    _unshared_copy(db_path, old)
+    with h5py.File(old, "r") as f:
+        assert data.MESHES not in f and isinstance(f[data.RUNS][input_key(inputs())]["mesh/X"], h5py.Dataset)
+    h = Database(old).content_hash
+    assert h == Database(db_path).content_hash  # a shared mesh hashes like one held by the run
+    assert _stored_meshes(old) == 3
+    data.compact(old)
+    assert _stored_meshes(old) == 1
+    with h5py.File(old, "r") as f:
+        assert len(f[data.MESHES]) == 1
+    assert Database(old).content_hash == h and len(Database(old)) == 4
+
+
+def test_removing_runs_drops_meshes_no_run_uses(tmp_path, results):
+    a = results[0]
+    path = tmp_path / "one.h5"
+    append_run(path, record(inputs(), a), a)
+    other = run_indentation(EPP, 1.0, 0.005, density=0.3, options=SolverOptions(**TINY))
+    inp = {**inputs(h_max=0.005), "mesh_density": 0.3}
+    append_run(path, record(inp, other), other)
+    with h5py.File(path, "r") as f:
+        assert len(f[data.MESHES]) == 2
+    data.remove_entries(path, [input_key(inp)])
+    with h5py.File(path, "r") as f:
+        assert len(f[data.MESHES]) == 1
+    assert np.array_equal(Database(path).run(input_key(inputs())).mesh["cells"], a.final["cells"])
+
+
 # ---------------------------------------------------------------------------- appending
 def test_append_refuses_duplicates_and_inconsistent_records(db_path, results):
     a, _, c = results
