@@ -135,6 +135,8 @@ CYCLES = {
     "increment_start": ("index", "first increment of the cycle's loading"),
     "increment_peak": ("index", "increment at h_max"),
     "increment_end": ("index", "last increment of the unloading (at h_res)"),
+    "F_end": ("force", "force at increment_end: 0, or > 0 when Newton failed below "
+                       "solver.UNLOAD_TAIL F_max and h_res is extrapolated from there"),
     "profile_r": ("length", "(n_cyc, n_surf) deformed r of the surface nodes at h_res"),
     "profile_z": ("length", "(n_cyc, n_surf) deformed z of the surface nodes at h_res"),
 }

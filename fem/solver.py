@@ -35,8 +35,14 @@ from .segment_penalty import SegmentPenalty
 #: stiffest elastic modulus (see ``_newton``; measured ~2e-14 M R² after a plastic cycle at
 #: ν = 0.45, where 3κ = 10 E)
 ROUNDOFF = 1e-15
-#: an unloading branch whose increment fails below this fraction of F_max ends there
-UNLOAD_TAIL = 1e-3
+#: an unloading branch whose increment fails below this fraction of F_max ends there, h_res
+#: extrapolated (``residual_approach``) and the force reached kept in ``cycles["F_end"]``.
+#: With heavy hardening the residual imprint is nearly conforming and the whole contact opens
+#: within a few per cent of F_max (campaign v2, flat, K/σY = 7.7-7.9, n = 0.52: Newton fails at
+#: 2.4-3.0 % of F_max). Cost measured on the 177 unloadings of campaign v2's first 49 runs cut at
+#: their first point below 5 % F_max: h_res within 2.5 % of the recovery h_max - h_res (median
+#: 0.25 %, 90 % within 1.5 %), always on the low side.
+UNLOAD_TAIL = 0.05
 
 
 def stiffest_modulus(material) -> float:
@@ -218,6 +224,35 @@ def new_active_log() -> dict:
     return {"changes": 0, "flips": 0, "frozen": False, "seen": set(), "res": []}
 
 
+#: residuals repeating every other iteration within this fraction make a 2-cycle
+CYCLE_MATCH = 0.05
+#: a 2-cycle is accepted as converged when both its residuals are within this factor of the tolerance
+CYCLE_ACCEPT = 10.0
+
+
+def two_cycle(res) -> bool:
+    """Newton ping-pongs between two states: each of the last two residuals within
+    ``CYCLE_MATCH`` of the one two iterations before (r_k ≈ r_(k−2), r_(k−1) ≈ r_(k−3))."""
+    if len(res) < 4:
+        return False
+    r = np.asarray(res[-4:], dtype=float)
+    return bool(abs(r[3] - r[1]) <= CYCLE_MATCH * r[3] and abs(r[2] - r[0]) <= CYCLE_MATCH * r[2])
+
+
+def cycle_converged(res, tol: float) -> bool:
+    """A 2-cycle (:func:`two_cycle`) with both residuals ≤ ``CYCLE_ACCEPT`` · ``tol``.
+
+    On unloading from large deformation with heavy hardening one Gauss point at the yield
+    surface can toggle between the elastic and the plastic branch every iteration (campaign
+    v2, rigid sphere R2/R1 = 2.91, K/σY = 8.1, E/σY = 41 at h/R = 0.2876: 1031/1030 plastic
+    points, Δγ = 1.35e-8 / 0, residuals 1.43e-8 / 1.87e-8 for 25 iterations; half steps keep
+    the cycle). Either state is equilibrium to ≤ 1e-7 of the largest reaction, the other
+    violating the yield condition at that point by about Δγ; the increment is accepted and
+    counted (``timings["cycled_increments"]``) rather than cut back below dh_min.
+    """
+    return two_cycle(res) and max(res[-2:]) <= CYCLE_ACCEPT * tol
+
+
 def plastic_dissipation(disc: Discretisation, material: Material, eps_p_n: np.ndarray,
                         dgamma: np.ndarray) -> float:
     """Dissipation of one increment, ∫ σ_f(ε_p,n + Δγ) Δγ dV₀ (backward Euler)."""
@@ -249,7 +284,7 @@ LOAD, UNLOAD, RELOAD = 0, 1, 2
 #: per-cycle summaries of ``RunResult.cycles`` (one value per unloading branch)
 CYCLE_KEYS = ("h_max", "F_max", "a_max", "h_res", "pole_radius", "work_in", "work_returned",
               "dissipation", "elastic_energy_change", "increment_start", "increment_peak",
-              "increment_end")
+              "increment_end", "F_end")
 
 
 def check_unload_at(unload_at, h_max: float) -> np.ndarray:
@@ -420,10 +455,12 @@ class CycleLegs:
         """Unload from the current approach until the force vanishes; the cycle's summary.
 
         Increments: about ``options.unload_increments`` over the elastic recovery estimated from
-        Sneddon's initial stiffness 2E*a, Δh ≈ 1.5 F_max/(2E*a). The last increment lands on
+        Sneddon's initial stiffness 2E*a, Δh ≈ 1.5 F_max/(2E*a); one cut back after a failed
+        increment grows again (``growth``) after each easy one, up to that step. The last increment lands on
         h_res, extrapolated from the last two points with F > 0 (:func:`residual_approach`).
-        When an increment fails once F ≤ ``UNLOAD_TAIL`` F_max (Newton at the roundoff floor of
-        a nearly unloaded body), the branch ends there with h_res extrapolated the same way.
+        When an increment fails once F ≤ ``UNLOAD_TAIL`` F_max (the contact of a nearly
+        unloaded body opening at once), the branch ends there with h_res extrapolated the same
+        way and the force reached kept as ``F_end`` (0 when the branch reached F = 0).
         """
         hist, R = self._hist, self._length
         i_peak = len(hist.h) - 1
@@ -463,6 +500,8 @@ class CycleLegs:
                 self._commit(run, h_new, solved, UNLOAD)
                 if lost or h_new == 0.0:
                     break
+                if run.last_iterations <= self.options.easy_iterations:  # back to the design step
+                    dh = min(dh * self.options.growth, run.dh_cycle)
                 continue
             lost, h_lost = True, h_new  # contact lost between run.h and h_new: land on h_res next
         base = run.cycle_base
@@ -476,6 +515,7 @@ class CycleLegs:
                  "dissipation": hist.dissipation[i_end] - base["dissipation"],
                  "elastic_energy_change": hist.energy_elastic[i_end] - base["energy_elastic"],
                  "increment_start": base["increment"], "increment_peak": i_peak, "increment_end": i_end,
+                 "F_end": hist.F[i_end] if tail else 0.0,
                  "profile_r": xs[0].copy(), "profile_z": xs[1].copy()}
         run.cycle_base = {"work": hist.work_external[i_end], "dissipation": hist.dissipation[i_end],
                           "energy_elastic": hist.energy_elastic[i_end], "increment": i_end + 1}
@@ -664,7 +704,10 @@ class IndentationSolver(CycleLegs):
             self.timers["contact"] += t3 - t2
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            if not changed and res <= max(opt.tol, floor) and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
+            cycled = not changed and cycle_converged(res_hist, max(opt.tol, floor))
+            if (not changed and res <= max(opt.tol, floor) or cycled) \
+                    and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
+                self.cycled_increments += cycled and res > max(opt.tol, floor)
                 return (u, upd, active, it, log["changes"], res_hist, f, gap, np.where(active, lam, 0.0),
                         normal)
             K = disc.matrix(data)
@@ -845,6 +888,7 @@ class IndentationSolver(CycleLegs):
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(opt.linear_solver)
         self.rejected = []
+        self.cycled_increments = 0
         hist = History()
         self._hist, self._progress = hist, progress
         targets = None
@@ -870,7 +914,8 @@ class IndentationSolver(CycleLegs):
         prof_g = np.array(hist.profile_g).reshape(-1, nsurf)
         timings = {"wall_s": wall, "setup_s": self.t_setup, **self._timer_split(),
                    "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum()),
-                   "rejected_increments": len(self.rejected), **{f"linear_{k}": v for k, v in
+                   "rejected_increments": len(self.rejected),
+                   "cycled_increments": self.cycled_increments, **{f"linear_{k}": v for k, v in
                                                                  self.linear.stats.items()}}
         final = {"X": self.X, "u": u, "cells": self.disc.basis.element_dofs.T.copy(),
                  "eps_p": state.eps_p.reshape(self.disc.n_elements, self.disc.n_qp)}

@@ -49,6 +49,7 @@ from .solver import (
     SolverOptions,
     _RunState,
     check_unload_at,
+    cycle_converged,
     cycles_as_arrays,
     finish_curves,
     new_active_log,
@@ -317,8 +318,10 @@ class TwoBodySolver(CycleLegs):
             log["res"].append(res)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            if not changed and res <= max(opt.tol, floor) and gap_err <= GAP_TOL * self.R:
+            cycled = not changed and cycle_converged(log["res"], max(opt.tol, floor))
+            if (not changed and res <= max(opt.tol, floor) or cycled) and gap_err <= GAP_TOL * self.R:
                 F = abs(float(np.sum(lam * kin.normal[1])))
+                self.cycled_increments += cycled and res > max(opt.tol, floor)
                 return u, per_body, f, active, lam, kin.gap, kin.normal, it, log, F
             Kc = self.contact.contact_stiffness(kin, active, lam)
             t3 = time.perf_counter()
@@ -422,9 +425,11 @@ class TwoBodySolver(CycleLegs):
             log["res"].append(res)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            if not changed and res <= max(opt.tol, floor):
+            cycled = not changed and cycle_converged(log["res"], max(opt.tol, floor))
+            if not changed and res <= max(opt.tol, floor) or cycled:
                 kin0, p0 = kins[0], self.passes[0]
                 F = sum(abs(float(np.sum(lp * k.normal[1]))) for lp, k in zip(lams, kins, strict=True))
+                self.cycled_increments += cycled and res > max(opt.tol, floor)
                 return (u, per_body, f, pens[0], lams[0] / p0.weight, kin0.gap, kin0.normal, it, log, F)
             t3 = time.perf_counter()
             self.timers["contact"] += t3 - t2
@@ -483,6 +488,7 @@ class TwoBodySolver(CycleLegs):
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(self.options.linear_solver)
         self.rejected = []
+        self.cycled_increments = 0
         run = _RunState(t_start=time.perf_counter(), u=np.zeros(self.n_dofs),
                         state=[PlasticState.virgin(b.disc.n_elements * b.disc.n_qp) for b in self.bodies],
                         active=np.zeros(self.candidates.size, dtype=bool), dh=opt.dh_first * R)
@@ -582,7 +588,8 @@ class TwoBodySolver(CycleLegs):
         timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
                    **{f"linear_{k}": v for k, v in self.linear.stats.items()},
                    "increments": int(curves["h"].size), "newton_iterations": int(curves["iterations"].sum()),
-                   "rejected_increments": len(self.rejected)}
+                   "rejected_increments": len(self.rejected),
+                   "cycled_increments": self.cycled_increments}
         b1, b2 = self.bodies
         inputs = {"scene": "two_body", "material": b1.material.describe(), "radius": b1.radius,
                   "material2": b2.material.describe(), "radius2": b2.radius,

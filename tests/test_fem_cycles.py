@@ -130,8 +130,8 @@ def test_cli_rejects_a_bad_schedule_before_any_work(tmp_path, capsys):
 
 def test_unloading_tail_that_fails_ends_the_branch_with_an_extrapolated_residual_approach(
         plastic_run, monkeypatch):
-    """Near zero force Newton can sit at the roundoff floor; below UNLOAD_TAIL F_max the branch
-    ends there (h_res extrapolated) instead of stopping the whole run. Simulated here: every
+    """Near zero force the whole contact can open at once and Newton fail; below UNLOAD_TAIL
+    F_max the branch ends there (h_res extrapolated, F_end kept) instead of stopping the run. Simulated here: every
     unloading step (h decreasing) from F < 1 % F_max fails, with UNLOAD_TAIL raised to 2 %."""
     from spherecontact.fem import solver as fs
 
@@ -156,6 +156,10 @@ def test_unloading_tail_that_fails_ends_the_branch_with_an_extrapolated_residual
     np.testing.assert_allclose(got, ref, rtol=0.02)  # extrapolated from F < 1 % F_max
     ends = res.cycles["increment_end"].astype(int)
     assert np.any(res.F[ends] > 0)  # a branch ended on its tail, before a solved state at F = 0
+    tail = res.cycles["F_end"] > 0
+    np.testing.assert_array_equal(res.cycles["F_end"][tail], res.F[ends][tail])
+    assert np.all(res.cycles["F_end"][tail] < 0.02 * res.cycles["F_max"][tail])
+    assert np.all(plastic_run.cycles["F_end"] == 0.0)  # branches that reached F = 0
     assert np.all(res.cycles["h_res"] <= res.h[ends] + 1e-15)
     monkeypatch.setattr(fs, "UNLOAD_TAIL", 1e-5)  # without the tail rule the run stops
     stopped = IndentationSolver(EPP, 1.0, density=0.5)

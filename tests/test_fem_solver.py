@@ -136,3 +136,16 @@ def test_prescribed_schedule_is_followed_and_bad_ones_are_named():
     np.testing.assert_allclose(res.h, np.append(sched, 0.005), rtol=1e-12)
     with pytest.raises(ValueError, match="schedule"):
         solver.run(0.005, schedule=[0.002, 0.001])
+
+
+def test_two_cycles_near_the_tolerance_count_as_converged():
+    """A Gauss point toggling at yield makes Newton repeat two residuals a few times the
+    tolerance (residuals of the stopped campaign v2 run); only such a cycle is accepted."""
+    from spherecontact.fem.solver import CYCLE_ACCEPT, cycle_converged, two_cycle
+
+    stopped = [2.63e-8, 2.33e-8, 3.05e-8, 2.33e-8, 3.05e-8]  # rsphere2.91-K8.12, h/R = 0.2876
+    assert two_cycle(stopped) and cycle_converged(stopped, 1e-8)
+    assert not two_cycle([1e-2, 1e-4, 1e-8]) and not two_cycle([3e-3, 6e-4, 1e-5, 2e-8])
+    assert not cycle_converged([2e-3, 6e-4, 2e-3, 6e-4], 1e-8)  # a cycle far from convergence
+    far = [x * 1.01 * CYCLE_ACCEPT / 3.05 for x in stopped]
+    assert two_cycle(far) and not cycle_converged(far, 1e-8)  # just beyond the accepted band
