@@ -178,11 +178,12 @@ class StressUpdate:
 
 
 def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None,
-                  stress_only: bool = False) -> StressUpdate | np.ndarray:
+                  stress_only: bool = False, elastic=None) -> StressUpdate | np.ndarray:
     """Exponential-map return mapping at deformation gradient ``F`` (real or complex).
 
     ``stress_only``: return P alone (what the complex-step tangent needs), skipping the
-    updated internal variables.
+    updated internal variables. ``elastic``: boolean mask of points kept elastic (Δγ = 0)
+    whatever their trial stress (Newton's frozen plastic set, ``solver.freeze_toggling``).
 
     ``dgamma``: the real plastic multiplier from a real call; with complex F it
     is completed to first order in the imaginary perturbation (one Newton step
@@ -221,6 +222,8 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None,
             if np.any(plastic):
                 dgamma[plastic] = solve_plastic_multiplier(
                     q_real[plastic], state_eps_p[plastic], material, mu)
+        if elastic is not None:
+            dgamma = np.where(elastic, 0.0, dgamma)
     plastic = dgamma > 0.0
     if np.iscomplexobj(q_tr):
         slope = material.flow_slope(state_eps_p + dgamma) if np.isfinite(material.sigma_y) else 0.0
@@ -257,13 +260,15 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None,
                         tau=np.stack([t11, t12, t22, ttt]))
 
 
-def stress_and_tangent(F, state: PlasticState, material: Material, real: StressUpdate | None = None):
+def stress_and_tangent(F, state: PlasticState, material: Material, real: StressUpdate | None = None,
+                       elastic=None):
     """Stress update at real F (shape (5, N)) and the tangent A[i, k] = ∂P_i/∂F_k, (5, 5, N).
 
     ``real``: the real stress update at this F when the caller already has it.
+    ``elastic``: points kept elastic (:func:`stress_update`).
     """
     if real is None:
-        real = stress_update(F, state.cp_inv, state.eps_p, material)
+        real = stress_update(F, state.cp_inv, state.eps_p, material, elastic=elastic)
     Fc = F[:, None, :] + 1j * CSTEP * np.eye(5)[:, :, None]
     P = stress_update(Fc, state.cp_inv[:, None, :], state.eps_p[None, :], material,
                       dgamma=real.dgamma[None, :], stress_only=True)

@@ -49,9 +49,9 @@ from .solver import (
     SolverOptions,
     _RunState,
     check_unload_at,
-    cycle_converged,
     cycles_as_arrays,
     finish_curves,
+    freeze_toggling,
     new_active_log,
     plastic_dissipation,
     stiffest_modulus,
@@ -260,8 +260,23 @@ class TwoBodySolver(CycleLegs):
         self.free = np.ones(self.n_dofs, dtype=bool)
         self.free[self.fixed] = False
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+        self._elastic = None
 
     # ------------------------------------------------------------------ bodies
+    def _body_elastic(self, i: int):
+        """Points of body ``i`` Newton keeps elastic in this increment (or None)."""
+        return None if self._elastic is None else self._elastic[i]
+
+    def _freeze(self, log: dict, per_body) -> None:
+        """:func:`~.solver.freeze_toggling` over the Gauss points of both bodies."""
+        plastic = [upd.dgamma > 0 for _, upd, _ in per_body]
+        flat = freeze_toggling(log, np.concatenate([m.ravel() for m in plastic]),
+                               None if self._elastic is None else
+                               np.concatenate([m.ravel() for m in self._elastic]))
+        if flat is not None:
+            parts = np.split(flat, np.cumsum([m.size for m in plastic])[:-1])
+            self._elastic = [part.reshape(m.shape) for part, m in zip(parts, plastic, strict=True)]
+
     def _stress(self, u, states, known=None):
         """Per body (F, stress update, tangent A) and the global internal force."""
         out, f = [], np.zeros(self.n_dofs)
@@ -270,7 +285,7 @@ class TwoBodySolver(CycleLegs):
                 Fv = b.disc.deformation_gradient(b.local(u))
                 if not positive_jacobian(Fv):
                     raise IncrementFailed(f"inverted element (J <= 0) in body {i + 1}")
-                upd, A = stress_and_tangent(Fv, st, b.material)
+                upd, A = stress_and_tangent(Fv, st, b.material, elastic=self._body_elastic(i))
                 fb = b.disc.internal_force(upd.P)
             else:
                 Fv, real, fb = known[i]
@@ -300,6 +315,7 @@ class TwoBodySolver(CycleLegs):
         nd, free = self.n_dofs, self.free
         scale = max(b.material.E * b.radius for b in self.bodies)  # λ = scale · μ
         log = new_active_log()
+        self._elastic = None  # per body: points kept elastic in this increment
         known, kin = None, None  # from the line search: stresses and contact kinematics at u
         for it in range(opt.max_iterations):
             per_body, f, K = self._bodies_state(u, states, known)
@@ -316,12 +332,12 @@ class TwoBodySolver(CycleLegs):
             floor = ROUNDOFF * max(stiffest_modulus(b.material) for b in self.bodies) * self.R**2 / ref
             gap_err = float(np.abs(kin.gap[active]).max(initial=0.0))
             log["res"].append(res)
+            self._freeze(log, per_body)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            cycled = not changed and cycle_converged(log["res"], max(opt.tol, floor))
-            if (not changed and res <= max(opt.tol, floor) or cycled) and gap_err <= GAP_TOL * self.R:
+            if not changed and res <= max(opt.tol, floor) and gap_err <= GAP_TOL * self.R:
                 F = abs(float(np.sum(lam * kin.normal[1])))
-                self.cycled_increments += cycled and res > max(opt.tol, floor)
+                self.plastic_frozen_increments += log.get("plastic_frozen", False)
                 return u, per_body, f, active, lam, kin.gap, kin.normal, it, log, F
             Kc = self.contact.contact_stiffness(kin, active, lam)
             t3 = time.perf_counter()
@@ -355,9 +371,9 @@ class TwoBodySolver(CycleLegs):
 
         def slope(trial):
             known, f = [], np.zeros(self.n_dofs)
-            for b, st in zip(self.bodies, states, strict=True):
+            for i, (b, st) in enumerate(zip(self.bodies, states, strict=True)):
                 Fv = b.disc.deformation_gradient(b.local(trial))
-                real = stress_update(Fv, st.cp_inv, st.eps_p, b.material)
+                real = stress_update(Fv, st.cp_inv, st.eps_p, b.material, elastic=self._body_elastic(i))
                 fb = b.disc.internal_force(real.P)
                 f[b.offset:b.offset + b.n_dofs] = fb
                 known.append((Fv, real, fb))
@@ -403,6 +419,7 @@ class TwoBodySolver(CycleLegs):
         first pass, λ scaled to a whole pass (1/w)."""
         opt, free = self.options, self.free
         log = new_active_log()
+        self._elastic = None  # per body: points kept elastic in this increment
         known, kins, prev = None, None, None
         for it in range(opt.max_iterations):
             per_body, f, K = self._bodies_state(u, states, known)
@@ -423,13 +440,13 @@ class TwoBodySolver(CycleLegs):
             res = float(np.abs(r[free]).max()) / ref
             floor = ROUNDOFF * max(stiffest_modulus(b.material) for b in self.bodies) * self.R**2 / ref
             log["res"].append(res)
+            self._freeze(log, per_body)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            cycled = not changed and cycle_converged(log["res"], max(opt.tol, floor))
-            if not changed and res <= max(opt.tol, floor) or cycled:
+            if not changed and res <= max(opt.tol, floor):
                 kin0, p0 = kins[0], self.passes[0]
                 F = sum(abs(float(np.sum(lp * k.normal[1]))) for lp, k in zip(lams, kins, strict=True))
-                self.cycled_increments += cycled and res > max(opt.tol, floor)
+                self.plastic_frozen_increments += log.get("plastic_frozen", False)
                 return (u, per_body, f, pens[0], lams[0] / p0.weight, kin0.gap, kin0.normal, it, log, F)
             t3 = time.perf_counter()
             self.timers["contact"] += t3 - t2
@@ -488,7 +505,7 @@ class TwoBodySolver(CycleLegs):
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(self.options.linear_solver)
         self.rejected = []
-        self.cycled_increments = 0
+        self.plastic_frozen_increments = 0
         run = _RunState(t_start=time.perf_counter(), u=np.zeros(self.n_dofs),
                         state=[PlasticState.virgin(b.disc.n_elements * b.disc.n_qp) for b in self.bodies],
                         active=np.zeros(self.candidates.size, dtype=bool), dh=opt.dh_first * R)
@@ -512,6 +529,11 @@ class TwoBodySolver(CycleLegs):
     @property
     def _length(self) -> float:
         return self.R
+
+    @property
+    def _step_scale(self) -> float:
+        """1: steps are already in units of the smaller radius (``_length``)."""
+        return 1.0
 
     def _pair_modulus(self) -> float:
         e1, e2 = (b.material.E_prime for b in self.bodies)
@@ -589,7 +611,7 @@ class TwoBodySolver(CycleLegs):
                    **{f"linear_{k}": v for k, v in self.linear.stats.items()},
                    "increments": int(curves["h"].size), "newton_iterations": int(curves["iterations"].sum()),
                    "rejected_increments": len(self.rejected),
-                   "cycled_increments": self.cycled_increments}
+                   "plastic_frozen_increments": self.plastic_frozen_increments}
         b1, b2 = self.bodies
         inputs = {"scene": "two_body", "material": b1.material.describe(), "radius": b1.radius,
                   "material2": b2.material.describe(), "radius2": b2.radius,

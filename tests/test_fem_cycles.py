@@ -131,8 +131,9 @@ def test_cli_rejects_a_bad_schedule_before_any_work(tmp_path, capsys):
 def test_unloading_tail_that_fails_ends_the_branch_with_an_extrapolated_residual_approach(
         plastic_run, monkeypatch):
     """Near zero force the whole contact can open at once and Newton fail; below UNLOAD_TAIL
-    F_max the branch ends there (h_res extrapolated, F_end kept) instead of stopping the run. Simulated here: every
-    unloading step (h decreasing) from F < 1 % F_max fails, with UNLOAD_TAIL raised to 2 %."""
+    F_max the branch ends there (h_res extrapolated, F_end kept) instead of stopping the run.
+    Simulated here: every unloading step (h decreasing) from F < 1 % F_max fails, with
+    UNLOAD_TAIL at 2 %."""
     from spherecontact.fem import solver as fs
 
     monkeypatch.setattr(fs, "UNLOAD_TAIL", 0.02)
