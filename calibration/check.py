@@ -24,6 +24,7 @@ import numpy as np
 
 from ..model import Material, Sphere, contact, contact_from_radius
 from ..model.coefficients import Coefficients
+from ..model.unified import pair
 from .dataset import RunCurve
 
 __all__ = ["STEP", "MAX_SLOPE", "MonotoneCheck", "check_pair", "grid_pairs", "check_all",
@@ -61,11 +62,13 @@ class MonotoneCheck:
 
 def check_pair(label: str, s1: Sphere, s2: Sphere, coeffs: Coefficients,
                a_range=(1e-6, 0.95)) -> MonotoneCheck:
-    """Monotonicity and continuity of the model for one pair (module docstring)."""
+    """Monotonicity and continuity of the model for one pair (module docstring), over
+    ``a_range`` (units of the smaller radius) cut at the end of the model's domain."""
     R = min(s1.radius, s2.radius)
-    lna = np.arange(math.log(a_range[0]), math.log(a_range[1]), STEP)
     with quiet_range_warnings():
-        st = contact_from_radius(s1, s2, R * np.exp(lna), coeffs=coeffs)
+        a_end = min(a_range[1] * R, pair(s1, s2, coeffs).domain.a_max)
+        lna = np.arange(math.log(a_range[0] * R), math.log(a_end), STEP)
+        st = contact_from_radius(s1, s2, np.exp(lna), coeffs=coeffs)
     h = st.h1 + st.h2
     dF = np.diff(np.log(st.F)) / STEP
     dh = np.diff(np.log(h)) / STEP

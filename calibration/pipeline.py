@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model.coefficients import Coefficients
-from ..model.single import effective_exponent
+from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
 from .crossval import CVResult, cross_validate_many
 from .dataset import Dataset, build_dataset, quantities
@@ -257,11 +257,13 @@ def _interval(values) -> list[float]:
 def calibrated_range(ds: Dataset, coeffs: Coefficients) -> dict:
     """The inputs the fit saw, as ``provenance["calibrated_range"]`` (read by ``model/``).
 
-    Materials of the calibration runs used (E/σ_Y and the hardening exponent of the bodies
-    that yield, ν of all; n: the Ludwik exponent, 0 for perfect plasticity, the secant
-    exponent of the model for a flow table), and over the calibration points of the fit:
-    the largest approach h/R and contact radius a/R of the body, and the Λ range with the
-    fitted β. Ends rounded outwards to ``SIGNIFICANT`` digits.
+    Materials of the calibration runs used (E/σ_Y, the hardening exponent and the hardening
+    magnitude K/σ_Y of the bodies that yield, ν of all; n: the Ludwik exponent, 0 for
+    perfect plasticity, the secant exponent of the model for a flow table; K/σ_Y:
+    ``single.hardening_magnitude``), the scenes (curvature ratio R/R_i of the body over its
+    rigid partner, 0 for a flat), and over the calibration points of the fit: the largest
+    approach h/R and contact radius a/R of the body, and the Λ range with the fitted β.
+    Ends rounded outwards to ``SIGNIFICANT`` digits.
     """
     mats = [c.material for c in ds.curves]
     plastic = [m for m in mats if math.isfinite(m.sigma_y)]
@@ -276,6 +278,9 @@ def calibrated_range(ds: Dataset, coeffs: Coefficients) -> dict:
         "h_over_R_max": _round_out(float(ds.h_R.max()), True),
         "a_over_R_max": _round_out(float(ds.x_R.max()), True),
         "Lambda": _interval(lam) if lam.size else None,
+        "K_over_sigma_y": _interval([hardening_magnitude(m, coeffs) for m in plastic]) if plastic
+        else None,
+        "R_over_R_rigid": _interval([c.radius / c.indenter_radius for c in ds.curves]),
     }
 
 

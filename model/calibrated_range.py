@@ -12,6 +12,19 @@ A coefficient file written by calibration carries the range of its FE data set i
         "Lambda": [min, max]            # Johnson's parameter Λ reached (null: not recorded)
     }
 
+Two further axes the calibration samples are optional keys (files written before they
+were recorded do not have them)::
+
+        "K_over_sigma_y": [min, max],   # hardening magnitude K/σ_Y (Ludwik; 0: perfectly
+                                        # plastic; a flow table: ``single.hardening_magnitude``)
+        "R_over_R_rigid": [min, max],   # curvature ratio R/R_rigid of the sphere over its rigid
+                                        # partner (0: a rigid flat; 1: a rigid sphere of radius R)
+
+Absent (or ``null``), they take the documented values of the v1 calibration design,
+:data:`DEFAULT_K_OVER_SIGMA_Y` = [0, 2] and :data:`DEFAULT_R_OVER_R_RIGID` = [0, 1] (the
+``[[calibration]]`` entries of ``data/campaign.toml``: K/σ_Y 0 and 2; a rigid flat or a rigid
+sphere of the body's radius), so these axes are checked for older files too.
+
 A ``null`` entry means the data set recorded none (e.g. no body that yields): ``Lambda``
 is then not checked (small Λ is Level I, exact Hertz, and large Λ is bounded through
 E/σ_Y and h/R anyway), every other key takes its value from :data:`DEFAULT_RANGE`.
@@ -22,7 +35,8 @@ defaults below are used.
 Files without the block (the built-in literature set, files written before calibration
 recorded it) get :data:`DEFAULT_RANGE`: the calibration design of the FE campaign
 (``data/campaign.toml``, ``[[calibration]]`` entries: E/σ_Y 10–10000, ν 0.2–0.45,
-Ludwik n 0–0.5, approaches up to h/R = 0.3), a contact radius below the sphere
+Ludwik n 0–0.5 and K/σ_Y 0–2, a rigid flat or a rigid sphere of the body's radius,
+approaches up to h/R = 0.3), a contact radius below the sphere
 radius (a/R < 1) and no Λ limit. Pairs of two deformable spheres: the
 ``[[validation]]`` entries of the same campaign reach a radius ratio of 4, a
 yield-stress ratio of 3 and a Young's-modulus ratio of 3
@@ -46,7 +60,10 @@ __all__ = [
     "DEFAULT_RADIUS_RATIO_MAX",
     "DEFAULT_YIELD_RATIO_MAX",
     "DEFAULT_E_RATIO_MAX",
+    "DEFAULT_K_OVER_SIGMA_Y",
+    "DEFAULT_R_OVER_R_RIGID",
     "RANGE_KEYS",
+    "OPTIONAL_INTERVAL_KEYS",
 ]
 
 
@@ -67,6 +84,12 @@ DEFAULT_RADIUS_RATIO_MAX = 4.0
 DEFAULT_YIELD_RATIO_MAX = 3.0
 #: largest Young's-modulus ratio of two deformable spheres of the validation set
 DEFAULT_E_RATIO_MAX = 3.0
+#: hardening magnitude K/σ_Y of the v1 calibration design (perfectly plastic and K/σ_Y = 2)
+DEFAULT_K_OVER_SIGMA_Y = (0.0, 2.0)
+#: curvature ratio R/R_rigid of the v1 calibration design (rigid flat 0, rigid sphere of radius R 1)
+DEFAULT_R_OVER_R_RIGID = (0.0, 1.0)
+#: optional interval keys of ``provenance["calibrated_range"]`` (absent or null: the default)
+OPTIONAL_INTERVAL_KEYS = ("K_over_sigma_y", "R_over_R_rigid")
 
 
 def _where(key: str) -> str:
@@ -85,6 +108,13 @@ def _interval(v, key: str) -> tuple[float, float]:
     lo, hi = _number(v[0], key), _number(v[1], key)
     if lo > hi:
         raise ValueError(f"coefficients: '{_where(key)}' needs min <= max, got {v!r}")
+    return lo, hi
+
+
+def _non_negative_interval(v, key: str) -> tuple[float, float]:
+    lo, hi = _interval(v, key)
+    if lo < 0.0:
+        raise ValueError(f"coefficients: '{_where(key)}' must lie in [0, inf), got {v!r}")
     return lo, hi
 
 
@@ -108,6 +138,8 @@ class CalibratedRange:
     radius_ratio_max: float = DEFAULT_RADIUS_RATIO_MAX
     yield_ratio_max: float = DEFAULT_YIELD_RATIO_MAX
     E_ratio_max: float = DEFAULT_E_RATIO_MAX
+    K_over_sigma_y: tuple[float, float] = DEFAULT_K_OVER_SIGMA_Y
+    R_over_R_rigid: tuple[float, float] = DEFAULT_R_OVER_R_RIGID
     source: str = "default"  # "provenance" (read from the coefficient set) or "default"
 
     @classmethod
@@ -140,6 +172,8 @@ class CalibratedRange:
             radius_ratio_max=get("radius_ratio_max", _positive, optional=True),
             yield_ratio_max=get("yield_ratio_max", _positive, optional=True),
             E_ratio_max=get("E_ratio_max", _positive, optional=True),
+            K_over_sigma_y=get("K_over_sigma_y", _non_negative_interval, optional=True),
+            R_over_R_rigid=get("R_over_R_rigid", _non_negative_interval, optional=True),
             source="provenance",
         )
 
@@ -150,6 +184,8 @@ class CalibratedRange:
                  else "default: the campaign's calibration design")
         return (f"E/σ_Y {self.E_over_sigma_y[0]:g}–{self.E_over_sigma_y[1]:g}, ν {self.nu[0]:g}–"
                 f"{self.nu[1]:g}, hardening exponent n {self.hardening_n[0]:g}–{self.hardening_n[1]:g}, "
+                f"K/σ_Y {self.K_over_sigma_y[0]:g}–{self.K_over_sigma_y[1]:g}, rigid partner "
+                f"R/R_rigid {self.R_over_R_rigid[0]:g}–{self.R_over_R_rigid[1]:g} (0: flat), "
                 f"h/R ≤ {self.h_over_R_max:g} (each sphere's own approach), a/R ≤ {self.a_over_R_max:g}"
                 f"{lam}; pairs: radius ratio ≤ "
                 f"{self.radius_ratio_max:g}, yield ratio ≤ {self.yield_ratio_max:g}, E ratio ≤ "
@@ -164,12 +200,14 @@ class CalibratedRange:
             "Lambda": None if self.Lambda is None else list(self.Lambda),
             "radius_ratio_max": self.radius_ratio_max, "yield_ratio_max": self.yield_ratio_max,
             "E_ratio_max": self.E_ratio_max,
+            "K_over_sigma_y": list(self.K_over_sigma_y), "R_over_R_rigid": list(self.R_over_R_rigid),
         }
 
 
 #: Range used when the coefficient set records none: the calibration design of the FE
-#: campaign (data/campaign.toml) — E/σ_Y 10–10000, ν 0.2–0.45, Ludwik n 0–0.5,
-#: h/R ≤ 0.3 —, a/R < 1 (the contact radius reaching the sphere radius), no Λ limit, and
+#: campaign (data/campaign.toml) — E/σ_Y 10–10000, ν 0.2–0.45, Ludwik n 0–0.5, K/σ_Y 0–2,
+#: rigid flat or rigid sphere of radius R, h/R ≤ 0.3 —, a/R < 1 (the contact radius reaching
+#: the sphere radius), no Λ limit, and
 #: the pair ratios of the validation set (radius 4, yield stress 3, Young's modulus 3).
 DEFAULT_RANGE = CalibratedRange(
     E_over_sigma_y=(10.0, 1e4),

@@ -212,6 +212,23 @@ def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
     return prefactor * np.exp(s)
 
 
+def continue_beyond(x, x_max):
+    """x_c = min(x, x_max) and u = x_c/x of the C¹ continuation beyond x_max (x > 0).
+
+    A term g(x) fitted on x ≤ x_max (value g_c, log slope S_c = dg/d ln x at x_c) is used as
+
+        g(x) = g_c + S_c (1 − u),   dg/d ln x = S_c u,        (u = x_max/x beyond x_max)
+
+    continuous with its slope at x_max and tending to the constant g_c + S_c as x → ∞; for
+    x ≤ x_max, u = 1 and g is the fitted term itself (bit for bit). ``x_max=None``: no
+    continuation (x_c = x, u = 1).
+    """
+    x = np.asarray(x, dtype=float)
+    if x_max is None:
+        return x, np.ones_like(x)
+    return np.minimum(x, x_max), x_max / np.maximum(x, x_max)   # u = 1.0 exactly up to x_max
+
+
 def _poly_and_slope(x, poly: tuple[float, ...]):
     """Σ_k c_k x^(k+1) and its log slope x d/dx = Σ_k (k+1) c_k x^(k+1)."""
     s = np.zeros_like(x)
@@ -240,25 +257,46 @@ class CollapseLimit:
     z_poly: tuple[float, ...] = ()
     xn_poly: tuple[float, ...] = ()
 
-    def log_and_slope(self, x, n=0.0, z=0.0):
+    def log_and_slope(self, x, n=0.0, z=0.0, x_max: float | None = None,
+                      z_max: float | None = None):
         """ln L, d ln L/d ln x = −exponent + Σ (k+1) x_poly[k] x^(k+1)
-        + n Σ (k+1) xn_poly[k] x^(k+1) and d ln L/d z, vectorised (x > 0)."""
+        + n Σ (k+1) xn_poly[k] x^(k+1) and d ln L/d z, vectorised (x > 0).
+
+        Beyond the fitted ranges the terms are continued C¹ to constants
+        (:func:`continue_beyond`): the x-dependence g(x) = −exponent ln x + Σ … beyond
+        ``x_max`` in ln x, the z-dependence Σ z_poly[k] z^(k+1) beyond ``z_max`` (≥ 0) in
+        ln(1 + z) = ln(R/ρ_H)."""
         x = np.asarray(x, dtype=float)
         z = np.asarray(z, dtype=float)
-        s, ds = _poly_and_slope(x, self.x_poly)
+        xc, u = continue_beyond(x, x_max)
+        s, ds = _poly_and_slope(xc, self.x_poly)
         if self.xn_poly:
-            sn, dsn = _poly_and_slope(x, self.xn_poly)
+            sn, dsn = _poly_and_slope(xc, self.xn_poly)
             n_ = np.asarray(n, dtype=float)
             s, ds = s + n_ * sn, ds + n_ * dsn
-        sz = np.zeros_like(z)  # Σ c_k z^(k+1)
-        dz = np.zeros_like(z)  # Σ (k+1) c_k z^k
-        for k in range(len(self.z_poly) - 1, -1, -1):
-            sz = (sz + self.z_poly[k]) * z
-            dz = dz * z + (k + 1) * self.z_poly[k]
-        with np.errstate(divide="ignore"):
-            lnL = (math.log(self.prefactor) - self.exponent * np.log(x) + s + sz
-                   + np.log(_exp_poly(1.0, self.exp_poly, n)))
+        if x_max is not None:
+            s, ds = s + (ds - self.exponent) * (1.0 - u), ds * u + self.exponent * (1.0 - u)
+        sz, dz = self._z_terms(z, z_max)
+        with np.errstate(divide="ignore"):  # x = 0 (a flat body): ln L = +inf, or finite if exponent 0
+            power = self.exponent * np.log(xc) if self.exponent else 0.0
+            lnL = math.log(self.prefactor) - power + s + sz + np.log(_exp_poly(1.0, self.exp_poly, n))
         return lnL, ds - self.exponent, dz
+
+    def _z_terms(self, z, z_max: float | None):
+        """Σ z_poly[k] z^(k+1) and its z-derivative, continued beyond z_max in ln(1 + z)."""
+        zc = z if z_max is None else np.minimum(z, z_max)
+        sz = np.zeros_like(zc)  # Σ c_k z^(k+1)
+        dz = np.zeros_like(zc)  # Σ (k+1) c_k z^k
+        for k in range(len(self.z_poly) - 1, -1, -1):
+            sz = (sz + self.z_poly[k]) * zc
+            dz = dz * zc + (k + 1) * self.z_poly[k]
+        if z_max is None or not self.z_poly or not np.any(z > z_max):
+            return sz, dz
+        S = (1.0 + zc) * dz  # d/d ln(1 + z) at z_c
+        u = (1.0 + zc) / (1.0 + np.maximum(z, z_max))
+        beyond = z > z_max
+        return (np.where(beyond, sz + S * (1.0 - u), sz),
+                np.where(beyond, S * u / (1.0 + np.maximum(z, z_max)), dz))
 
     def __call__(self, x, n=0.0, z=0.0):
         return np.exp(self.log_and_slope(x, n, z)[0])
@@ -476,6 +514,22 @@ class Coefficients:
         :data:`~spherecontact.model.calibrated_range.DEFAULT_RANGE` (the calibration design
         of the FE campaign) when the provenance records none."""
         return CalibratedRange.from_provenance(self.provenance)
+
+    @property
+    def x_fit_max(self) -> float:
+        """Largest finite-size ratio the x-dependent terms (finite-size factors, collapse
+        limits) were fitted on: ``calibrated_range.a_over_R_max`` (default 1, a/R < 1).
+        Beyond it they are continued C¹ to constants (``levels.continue_beyond``), so F(h)
+        and a(h) stay finite and increasing however far the approach goes."""
+        return self.calibrated_range.a_over_R_max
+
+    @property
+    def z_fit_max(self) -> float:
+        """Largest curvature ratio z = R/ρ_H − 1 the collapse limits' z-terms were fitted on:
+        the largest R/R_rigid of the calibration scenes (``calibrated_range.R_over_R_rigid``,
+        default 1: a rigid sphere of the body's radius). Beyond it the z-terms are continued C¹
+        to constants, so a small rigid indenter does not drive the limits to 0 or ∞."""
+        return self.calibrated_range.R_over_R_rigid[1]
 
     # ------------------------------------------------------------------ Level I and III values
     @property

@@ -1,6 +1,9 @@
 """Public entry point: ``contact(s1, s2, h)`` — force, contact radius, split and stiffness.
 
-h ≤ 0 means no contact: F = a = h1 = h2 = stiffness = 0 there (not an error).
+h ≤ 0 means no contact: F = a = h1 = h2 = stiffness = 0 there (not an error). Approaches
+beyond the model's domain (``UnifiedPair.domain``: a deformable sphere's own approach above
+its radius, or a contact radius above a rigid sphere's radius) raise a ValueError naming h,
+its value and the allowed range.
 Inputs outside the calibrated range give a
 :class:`~spherecontact.model.calibrated_range.CalibrationRangeWarning` per cause and call
 (``range_check.py``); the values are still returned.
@@ -68,6 +71,11 @@ def contact(s1: Sphere, s2: Sphere, h, coeffs: Coefficients | None = None) -> Co
     ContactState with F, a, h1, h2, stiffness = dF/dh, p_m, κ, ρ_1, ρ_2 shaped like h
     (NumPy scalars for scalar h). Outside contact all fields are 0 except ρ_i (inf).
 
+    Raises
+    ------
+    ValueError if an approach lies beyond the model's domain 0 < h ≤ h_max of the pair
+    (``UnifiedPair.domain``); the message names h, its value and the allowed range.
+
     Warns
     -----
     CalibrationRangeWarning, once per cause and call, for materials, pairs, approaches
@@ -97,14 +105,17 @@ def contact_from_radius(s1: Sphere, s2: Sphere, a, coeffs: Coefficients | None =
     """The unified model given the contact radius (DESIGN §3, forward direction).
 
     Returns the full :class:`~spherecontact.model.unified.UnifiedState` (κ, ρ_1, ρ_2,
-    p_m, h_1, h_2, h, F, dF/dh, Λ_1, Λ_2) as 1-D arrays for contact radii a > 0.
+    p_m, h_1, h_2, h, F, dF/dh, Λ_1, Λ_2) as 1-D arrays for contact radii 0 < a ≤ a_max
+    (``UnifiedPair.domain``; beyond it a ValueError names a and the allowed range).
     Warns like :func:`contact`.
     """
     aa = as_approach(a).reshape(-1)
     if not np.all(aa > 0.0):
         raise ValueError("a (contact radius) must be > 0")
     co = default_coefficients() if coeffs is None else coeffs
-    st = pair(s1, s2, co).state_at_a(aa)
+    p = pair(s1, s2, co)
+    p.check_radius(aa)
+    st = p.state_at_a(aa)
     chk = range_check(s1, s2, co)
     emit([*chk.static.values(), *chk.messages(chk.check_state(st))])
     return st

@@ -62,7 +62,9 @@ class ContactLaw:
     Parameters
     ----------
     s1, s2 : the spheres.
-    h_max : largest approach tabulated; default 0.5·min(R_1, R_2) (R* for a flat partner).
+    h_max : largest approach tabulated; default 0.5·min(R_1, R_2) (R* for a flat partner),
+        at most the end of the model's domain (``UnifiedPair.domain``; a larger h_max raises
+        ValueError naming it and the allowed range, as do approaches beyond it later).
     h_min : smallest approach tabulated; default 1e-10·R*. Below it and above h_max
         the exact solve is used.
     coeffs : coefficient set; default ``data/coefficients.json``.
@@ -97,12 +99,13 @@ class ContactLaw:
         if h_max is None:
             h_max = 0.5 * min(s1.radius, s2.radius) if math.isfinite(min(s1.radius, s2.radius)) \
                 else 0.5 * Rs
-            h_max = max(h_max, 0.5 * Rs)
+            h_max = min(max(h_max, 0.5 * Rs), self.pair.domain.h_max)
         if h_min is None:
             h_min = 1e-10 * Rs
         for name, v in (("h_max", h_max), ("h_min", h_min)):
             if not (isinstance(v, int | float) and math.isfinite(v) and v > 0.0):
                 raise ValueError(f"{name} must be a finite number > 0, got {v!r}")
+        self.pair.check_approach(h_max, "h_max")
         if not h_min < h_max:
             raise ValueError(f"need h_min < h_max, got h_min={h_min!r}, h_max={h_max!r}")
         if not rtol > 0.0:

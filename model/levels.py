@@ -13,6 +13,11 @@ both ends (Hertz at Λ_I, flat at Λ_III) plus t²(1 − t)²·Σ_k b_k t^k: H̄
 and vectorised; ``n`` is the effective hardening exponent (broadcast with Λ).
 The finite-size factor 1 + Σ_k f_k x^(k+1) multiplies H̄ and c² (x = a/ρ or a/R); its
 coefficients move from Level I to Level III values with the level weight s = 3t² − 2t³.
+Beyond the largest calibrated ratio x_max (``Coefficients.x_fit_max``) every x-dependent
+term (finite-size factors, collapse limits) is continued C¹ to a constant
+(:func:`continue_beyond`), and so are the collapse limits' z-terms beyond the largest
+calibrated curvature ratio (``Coefficients.z_fit_max``): the polynomials are used only
+where they were fitted.
 The large-deformation collapse (:func:`collapse_blend`) then blends these half-space
 values with the whole-body limits H̄_c(x, n), c²_c(x, n):
 
@@ -28,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .coefficients import Coefficients
+from .coefficients import Coefficients, continue_beyond
 
 __all__ = [
     "C2_HERTZ",
@@ -37,6 +42,7 @@ __all__ = [
     "c2",
     "H_bar_and_slope",
     "c2_and_slope",
+    "continue_beyond",
     "finite_size_factor",
     "level_weight",
     "finite_size_by_level",
@@ -157,21 +163,27 @@ def c2_and_slope(Lambda, coeffs: Coefficients, n=0.0):
     return c, slope
 
 
-def finite_size_factor(x, poly: tuple[float, ...]):
+def finite_size_factor(x, poly: tuple[float, ...], x_max: float | None = None):
     """Factor f(x) = 1 + Σ_k poly[k] x^(k+1) and its log slope d ln f/d ln x.
 
-    f(0) = 1 exactly: the correction vanishes as x → 0 (DESIGN §2).
+    f(0) = 1 exactly: the correction vanishes as x → 0 (DESIGN §2). Beyond ``x_max`` (the
+    largest calibrated ratio) ln f is continued to a constant (:func:`continue_beyond`), so a
+    polynomial fitted up to x_max never turns f negative or F(h) non-monotone at large x.
     """
     x = np.asarray(x, dtype=float)
     if not poly:
         return np.ones_like(x), np.zeros_like(x)
-    s = np.zeros_like(x)   # Σ c_k x^(k+1)
-    ds = np.zeros_like(x)  # Σ (k+1) c_k x^(k+1)
+    xc, u = continue_beyond(x, x_max)  # (x, 1) for x_max None
+    s = np.zeros_like(xc)   # Σ c_k x^(k+1)
+    ds = np.zeros_like(xc)  # Σ (k+1) c_k x^(k+1)
     for k in range(len(poly) - 1, -1, -1):
-        s = (s + poly[k]) * x
-        ds = (ds + (k + 1) * poly[k]) * x
+        s = (s + poly[k]) * xc
+        ds = (ds + (k + 1) * poly[k]) * xc
     f = 1.0 + s
-    return f, ds / f
+    slope = ds / f
+    if x_max is None:
+        return f, slope
+    return f * np.exp(slope * (1.0 - u)), slope * u
 
 
 class CollapseBlend(NamedTuple):
@@ -210,8 +222,9 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     zero = np.zeros_like(H_hs)
     if not coeffs.has_collapse:
         return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero, zero, zero, zero)
-    lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, z)
-    lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, z)
+    xm, zm = coeffs.x_fit_max, coeffs.z_fit_max
+    lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, z, xm, zm)
+    lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, z, xm, zm)
     H, c, w, gap, wc = blend_from_logs(H_hs, c2_hs, lnHc, lncc, coeffs.collapse_sharpness,
                                        coeffs.collapse_sharpness_c2, coeffs.collapse_offset_c2)
     return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero, wc)
@@ -250,13 +263,15 @@ def level_weight(Lambda, coeffs: Coefficients):
     return t * t * (3.0 - 2.0 * t), 6.0 * t * (1.0 - t) / L
 
 
-def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[float, ...]):
-    """Factor f = 1 + Σ_k [e_k (1 − s) + q_k s] x^(k+1) and its log slopes.
+def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[float, ...],
+                         x_max: float | None = None):
+    """Factor f = (1 − s) f_e + s f_p, f_e,p = 1 + Σ_k {e_k, q_k} x^(k+1), and its log slopes.
 
     Parameters
     ----------
     x : finite-size ratio; s, ds : level weight and ds/d ln Λ (:func:`level_weight`);
-    elastic, plastic : coefficients e_k (Level I) and q_k (Level III).
+    elastic, plastic : coefficients e_k (Level I) and q_k (Level III);
+    x_max : f_e and f_p are continued to constants beyond it (:func:`finite_size_factor`).
 
     Returns
     -------
@@ -264,10 +279,10 @@ def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[fl
     """
     x = np.asarray(x, dtype=float)
     if elastic == plastic:
-        f, dx = finite_size_factor(x, elastic)
+        f, dx = finite_size_factor(x, elastic, x_max)
         return f, dx, np.zeros_like(f)
-    fe, de = finite_size_factor(x, elastic)
-    fp, dp = finite_size_factor(x, plastic)
+    fe, de = finite_size_factor(x, elastic, x_max)
+    fp, dp = finite_size_factor(x, plastic, x_max)
     f = (1.0 - s) * fe + s * fp
     return f, ((1.0 - s) * fe * de + s * fp * dp) / f, (fp - fe) * ds / f
 
@@ -275,8 +290,9 @@ def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[fl
 def _factors(Lambda, x, coeffs: Coefficients):
     """Finite-size factors of H̄ and c² at (Λ, x)."""
     s, ds = level_weight(Lambda, coeffs)
-    fH = finite_size_by_level(x, s, ds, coeffs.finite_size_H_bar, coeffs.fs_H_bar_plastic)[0]
-    fc = finite_size_by_level(x, s, ds, coeffs.finite_size_c2, coeffs.fs_c2_plastic)[0]
+    xm = coeffs.x_fit_max
+    fH = finite_size_by_level(x, s, ds, coeffs.finite_size_H_bar, coeffs.fs_H_bar_plastic, xm)[0]
+    fc = finite_size_by_level(x, s, ds, coeffs.finite_size_c2, coeffs.fs_c2_plastic, xm)[0]
     return fH, fc
 
 

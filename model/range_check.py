@@ -5,9 +5,13 @@ What is checked (limits from :attr:`Coefficients.calibrated_range`, see
 flats R = ∞ — they are the calibration scene):
 
 * per deformable sphere i, once per pair: ν_i; for a body that yields (σ_Y finite),
-  E_i/σ_Y,i and the hardening exponent n_i — the Ludwik n (0 when K = 0), or for a
+  E_i/σ_Y,i, the hardening exponent n_i — the Ludwik n (0 when K = 0), or for a
   flow table its secant exponent, the n the model uses for H̄_III(n), c²_III(n)
-  (``single.effective_exponent``);
+  (``single.effective_exponent``) — and the hardening magnitude K_i/σ_Y,i (for a flow
+  table the Ludwik fit of ``single.hardening_magnitude``);
+* a deformable sphere (finite R) against a rigid body, once per pair: the radius ratio
+  R_rigid/R of the calibration scenes (a rigid flat, R_rigid = ∞, or a rigid sphere),
+  checked as the curvature ratio R/R_rigid against ``R_over_R_rigid``;
 * pair of two deformable spheres, once per pair: R_max/R_min (both radii finite),
   E_max/E_min, and σ_Y,max/σ_Y,min (both bodies yield);
 * per call, over all contacts together (NumPy reductions, no loop over points):
@@ -37,7 +41,7 @@ import numpy as np
 
 from .calibrated_range import CalibratedRange, CalibrationRangeWarning
 from .coefficients import Coefficients
-from .single import effective_exponent, flow_log_slope
+from .single import effective_exponent, flow_log_slope, hardening_magnitude
 from .sphere import Sphere
 
 __all__ = ["RangeCheck", "range_check", "emit"]
@@ -115,6 +119,8 @@ class RangeCheck:
             self._material(i, s, coeffs)
         if len(deform) == 2:
             self._pair(s1, s2)
+        else:
+            self._rigid_partner(s1, s2)
         #: (i, R_i) of the deformable spheres whose own approach h_i/R_i is checked
         self.R_bodies = [(i, s.radius) for i, s in deform if not s.is_flat]
         finite_all = [s.radius for _, s in bodies if not s.is_flat]
@@ -151,6 +157,23 @@ class RangeCheck:
         else:
             n, name = (m.n if m.K > 0.0 else 0.0), "hardening exponent n"
         self._flag(f"hardening_n_{i}", name, n, rng.hardening_n, who)
+        name = "hardening magnitude K/sigma_y" + (" (Ludwik fit, flow table)" if m.is_tabulated else "")
+        self._flag(f"K_over_sigma_y_{i}", name, hardening_magnitude(m, coeffs), rng.K_over_sigma_y, who)
+
+    def _rigid_partner(self, s1: Sphere, s2: Sphere) -> None:
+        """Radius ratio R_rigid/R of a deformable sphere against a rigid body (flat: ∞),
+        checked as R/R_rigid ∈ ``R_over_R_rigid`` (the calibration scenes)."""
+        (i, body), (j, rigid) = ((1, s1), (2, s2)) if s2.is_rigid else ((2, s2), (1, s1))
+        if body.is_flat:
+            return  # a half-space: the a/R → 0 limit of every calibration scene
+        z = body.radius / rigid.radius  # 0 for a rigid flat
+        r = self.range.R_over_R_rigid
+        if _outside(z, r):
+            inv = tuple(math.inf if v == 0.0 else 1.0 / v for v in (r[1], r[0]))
+            self.static["R_rigid_over_R"] = (
+                f"radius ratio R_rigid/R = {_fmt_out(rigid.radius / body.radius, *inv)} of rigid "
+                f"sphere {j} over sphere {i} is outside the calibrated range {_interval(inv)} "
+                f"(inf: a rigid flat){_TAIL}")
 
     def _pair(self, s1: Sphere, s2: Sphere) -> None:
         rng = self.range

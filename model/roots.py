@@ -26,6 +26,7 @@ def solve_increasing(
     tol: float = 1e-13,
     max_step: float = 4.0,
     maxiter: int = 200,
+    describe: Callable[[np.ndarray], str] | None = None,
 ) -> np.ndarray:
     """Solve f(x) = 0 element-wise for f increasing in x.
 
@@ -38,6 +39,8 @@ def solve_increasing(
     tol : absolute convergence tolerance on x (x is a log variable in this package).
     max_step : largest Newton step accepted while the bracket is open on that side.
     maxiter : iteration limit; ValueError if some elements have not converged.
+    describe : ``describe(idx) -> str`` names the inputs of the elements ``idx`` in the
+        ValueError raised when they do not converge or f is NaN there.
 
     Returns
     -------
@@ -56,6 +59,7 @@ def solve_increasing(
     for it in range(maxiter):
         if idx.size == 0:
             return x
+        _check_defined(fx, x[idx], idx, n, describe)
         xi = x[idx]
         done = fx == 0.0
         pos = fx > 0.0
@@ -67,7 +71,7 @@ def solve_increasing(
         f_hi[idx] = np.where(pos, fx, np.where(neg & (s_old == -1), 0.5 * f_hi[idx], f_hi[idx]))
         side[idx] = np.where(pos, 1, np.where(neg, -1, s_old))
         l, h = lo[idx], hi[idx]
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             newton = xi - fx / dx
         ok = np.isfinite(newton) & (dx > 0.0) & (newton > l) & (newton < h)
         ok &= np.abs(newton - xi) <= np.where(np.isfinite(l) & np.isfinite(h), np.inf, max_step)
@@ -90,4 +94,18 @@ def solve_increasing(
         if idx.size == 0:
             return x
         fx, dx = f(x[idx], idx)
-    raise ValueError(f"root solve did not converge for {idx.size} of {n} elements")
+    raise ValueError(_failure(f"root solve did not converge for {idx.size} of {n} elements", idx,
+                              describe))
+
+
+def _failure(text: str, idx: np.ndarray, describe) -> str:
+    """The error text, with the inputs of the failing elements if ``describe`` is given."""
+    return text if describe is None else f"{text}: {describe(idx)}"
+
+
+def _check_defined(fx, xi, idx, n: int, describe) -> None:
+    """ValueError naming the inputs where f is NaN (no sign, so no bracket can be kept)."""
+    bad = np.isnan(fx)
+    if np.any(bad):
+        raise ValueError(_failure(f"root solve: the equation is undefined (NaN) for {int(bad.sum())} of "
+                                  f"{n} elements (e.g. at x = {xi[bad][0]:.6g})", idx[bad], describe))

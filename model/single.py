@@ -45,6 +45,7 @@ __all__ = [
     "curvature_ratio",
     "flow_log_slope",
     "effective_exponent",
+    "hardening_magnitude",
     "BodyResponse",
     "BodyLaw",
     "IndentState",
@@ -95,6 +96,26 @@ def effective_exponent(material: Material, coeffs: Coefficients) -> float:
     return float(math.log(s_hi / s_lo) / math.log(coeffs.eps_hi / coeffs.eps_lo))
 
 
+def hardening_magnitude(material: Material, coeffs: Coefficients) -> float:
+    """Hardening magnitude K/σ_Y of a flow curve (the calibrated-range axis next to n).
+
+    Ludwik σ_Y + K εⁿ: K/σ_Y (0 for perfect plasticity or an elastic body). Flow table: the
+    Ludwik curve through σ_f at ε = 0, ε_lo and ε_hi (``hardening_exponent`` strains),
+    Δσ = σ_f(ε) − σ_f(0): n_L = ln(Δσ(ε_hi)/Δσ(ε_lo))/ln(ε_hi/ε_lo) clipped to [0, 1],
+    K = Δσ(ε_hi)/ε_hi^n_L — exact for a tabulated Ludwik curve.
+    """
+    if material.is_rigid or math.isinf(material.sigma_y):
+        return 0.0
+    if not material.is_tabulated:
+        return material.K / material.sigma_y
+    s0, s_lo, s_hi = material.flow_stress(np.array([0.0, coeffs.eps_lo, coeffs.eps_hi]))
+    d_lo, d_hi = s_lo - s0, s_hi - s0
+    if d_hi <= 0.0:
+        return 0.0
+    n_l = 1.0 if d_lo <= 0.0 else math.log(d_hi / d_lo) / math.log(coeffs.eps_hi / coeffs.eps_lo)
+    return float(d_hi / coeffs.eps_hi ** min(max(n_l, 0.0), 1.0) / s0)
+
+
 def _segment(material: Material, eps) -> np.ndarray:
     """Index of the flow-curve piece containing ε (0 for Ludwik curves)."""
     if not material.is_tabulated:
@@ -114,7 +135,7 @@ class BodyResponse(NamedTuple):
     dlnp_dlny: np.ndarray  # ∂ln p_m/∂ln y (finite-size factor)
     dlnc2_dlnx: np.ndarray
     dlnc2_dlny: np.ndarray
-    piece: np.ndarray      # smooth-piece id (level and flow-table segment); kinks where it changes
+    piece: np.ndarray      # smooth-piece id (level, flow-table segment, continuation); kinks where it changes
 
 
 @dataclass(frozen=True)
@@ -126,6 +147,8 @@ class BodyLaw:
     n_eff: float = field(init=False)
     H_bar_III: float = field(init=False)
     c2_III: float = field(init=False)
+    x_fit_max: float = field(init=False)   # fitted terms continued beyond (``levels.py``)
+    continued: bool = field(init=False)    # the set has x-dependent terms to continue
 
     def __post_init__(self) -> None:
         if self.material.is_rigid:
@@ -134,6 +157,8 @@ class BodyLaw:
         object.__setattr__(self, "n_eff", n)
         object.__setattr__(self, "H_bar_III", float(self.coeffs.H_bar_III(n)))
         object.__setattr__(self, "c2_III", float(self.coeffs.c2_III(n)))
+        object.__setattr__(self, "x_fit_max", self.coeffs.x_fit_max)
+        object.__setattr__(self, "continued", self.coeffs.has_finite_size)
 
     @property
     def E_prime(self) -> float:
@@ -160,9 +185,12 @@ class BodyLaw:
         with np.errstate(invalid="ignore"):
             p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
         s_l, ds_l = level_weight(Lam, co)
-        fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic)
-        fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic)
+        xm = self.x_fit_max
+        fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
+        fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
         piece = lev + 3 * _segment(mat, eps)
+        if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
+            piece = 2 * piece + (y > xm)
         p, c = p * fH, c * fc
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc

@@ -16,12 +16,23 @@ radii: ρ_1 = ρ_2 = 2R*) and a rigid partner (ρ = R* for the deformable body).
 
 The stiffness dF/dh is exact: implicit differentiation of g(u; a) = 0 gives
 du/d ln a = −(∂g/∂ln a)/(∂g/∂u), and dF/dh = (dF/d ln a)/(dh/d ln a).
+
+Domain (:attr:`UnifiedPair.domain`): h(a) and F(a) rise for every a > 0 (the large-
+deformation terms are continued to constants beyond their fitted range, ``levels.py``), but
+geometry bounds the approach: each deformable sphere's own approach stays within its radius,
+h_i ≤ R_i (h_i is the shortening of the hemisphere of height R_i, DESIGN §4; at h_i = R_i it
+is flattened completely). The first sphere to reach it as a grows gives a_max and
+h_max = h(a_max); approaches beyond h_max (radii beyond a_max) raise a ValueError naming h
+(a) and the allowed range. A deformable flat has no such bound. (A contact radius beyond a
+rigid indenter's radius is geometrically impossible too, but it is not a bound here: the
+model reaches it inside the validation window for small indenters; the a/R check of
+``range_check.py`` warns there.)
 """
 
 from __future__ import annotations
 
 import math
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -31,7 +42,7 @@ from .roots import solve_increasing
 from .single import BodyLaw, BodyResponse, curvature_ratio
 from .sphere import Sphere
 
-__all__ = ["UnifiedState", "UnifiedPair", "pair"]
+__all__ = ["UnifiedState", "UnifiedPair", "Domain", "pair"]
 
 
 class UnifiedState(NamedTuple):
@@ -53,6 +64,50 @@ class UnifiedState(NamedTuple):
     dlnF_dlna: np.ndarray  # d ln F/d ln a
     dlnh_dlna: np.ndarray  # d ln h/d ln a
     dlnh1_dlna: np.ndarray  # d ln h_1/d ln a (0 if body 1 is rigid)
+
+
+class Domain(NamedTuple):
+    """Approaches the model accepts, 0 < h ≤ h_max, i.e. contact radii 0 < a ≤ a_max."""
+
+    h_max: float  # inf: unbounded
+    a_max: float
+    bound: str    # the geometric bound reached at h_max (for messages)
+
+
+#: multiplier of body 2's piece id in the pair's piece id (ids of one body stay below it)
+_PIECES = 1 << 32
+#: relative slack of the domain checks (the domain end of a general pair is found to ~1e-12,
+#: the inversion h → a is exact to ~1e-14)
+_DOMAIN_SLACK = 1.0 + 1e-9
+#: sections per pass and passes of the search for the domain end of a general pair
+_DOMAIN_SECTIONS = 64
+_DOMAIN_PASSES = 6
+
+
+def _num(x: float) -> str:
+    return f"{x:.6g}"
+
+
+def _sphere_text(i: int, s: Sphere) -> str:
+    """Sphere i's radius and material, for error messages."""
+    m = s.material
+    if m.is_rigid:
+        mat = "rigid"
+    elif m.is_tabulated:
+        mat = f"E = {_num(m.E)}, nu = {_num(m.nu)}, flow table of {len(m.eps_table)} points"
+    elif math.isinf(m.sigma_y):
+        mat = f"E = {_num(m.E)}, nu = {_num(m.nu)}, elastic"
+    else:
+        mat = (f"E = {_num(m.E)}, nu = {_num(m.nu)}, sigma_y = {_num(m.sigma_y)}, K = {_num(m.K)}, "
+               f"n = {_num(m.n)}")
+    return f"sphere {i}: R = {_num(s.radius)}, {mat}"
+
+
+def _values(v: np.ndarray) -> str:
+    """Up to three values of an array, for error messages."""
+    v = np.asarray(v).ravel()
+    text = ", ".join(_num(float(x)) for x in v[:3])
+    return text + (f", … ({v.size} values)" if v.size > 3 else "")
 
 
 def _sigmoid(u):
@@ -126,6 +181,10 @@ class UnifiedPair:
         g = np.log(r1.p_m) - np.log(r2.p_m)
         return g, A1 * w2 + A2 * w1, r1, r2
 
+    def describe(self) -> str:
+        """Both spheres (radius, material), for error messages."""
+        return f"{_sphere_text(1, self.s1)}; {_sphere_text(2, self.s2)}"
+
     def solve_u(self, a, u_guess=None) -> np.ndarray:
         """κ solve: u = ln(ρ_2/ρ_1) with equal mean pressures, for each a (1-D)."""
         a = np.asarray(a, dtype=float)
@@ -135,7 +194,10 @@ class UnifiedPair:
             g, dg, _, _ = self._g(a[idx], u)
             return g, dg
 
-        return solve_increasing(f, u0, step=1.0, tol=1e-14)
+        def describe(idx):
+            return f"interface-curvature solve at contact radius a = {_values(a[idx])} ({self.describe()})"
+
+        return solve_increasing(f, u0, step=1.0, tol=1e-14, describe=describe)
 
     # ------------------------------------------------------------------ state given a
     def state_at_a(self, a, u=None) -> UnifiedState:
@@ -203,7 +265,7 @@ class UnifiedPair:
         if self.mode == "equal":  # exact closed form, no rounding from 1/R1 − 1/(2R*)
             kappa = np.full_like(a, 0.5 * (1.0 / R1 - 1.0 / R2))
         return UnifiedState(a, kappa, rho1, rho2, p, h1, h2, h, F, stiff,
-                            r1.Lambda, r2.Lambda, r1.piece + 1000 * r2.piece, dlnF, dh / h, dlnh1)
+                            r1.Lambda, r2.Lambda, r1.piece + _PIECES * r2.piece, dlnF, dh / h, dlnh1)
 
     # ------------------------------------------------------------------ inversion h → a
     def _invert(self, h):
@@ -211,11 +273,15 @@ class UnifiedPair:
         h = np.asarray(h, dtype=float)
         lnh = np.log(h)
         t0 = 0.5 * (lnh + math.log(self.R_star))  # Hertz: a² = R* h
+
+        def describe(idx):
+            return f"inversion h -> a at h = {_values(h[idx])} ({self.describe()})"
+
         if self.mode != "general":
             def f(t, idx):
                 s = self.state_at_a(np.exp(t))
                 return np.log(s.h) - lnh[idx], s.dlnh_dlna
-            return np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14)), None
+            return np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14, describe=describe)), None
 
         u_warm = np.full(h.shape, self._u0)
 
@@ -226,20 +292,107 @@ class UnifiedPair:
             s = self.state_at_a(a, u)
             return np.log(s.h) - lnh[idx], s.dlnh_dlna
 
-        a = np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14))
+        a = np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14, describe=describe))
         return a, self.solve_u(a, u_warm)
 
     def a_from_h(self, h) -> np.ndarray:
-        """Contact radius for approaches h (1-D, > 0): monotone root of h(a) = h in ln a."""
+        """Contact radius for approaches h (1-D, 0 < h ≤ ``domain.h_max``): monotone root of
+        h(a) = h in ln a."""
+        self.check_approach(h)
         return self._invert(h)[0]
 
     def state_from_h(self, h) -> UnifiedState:
-        """Full state for approaches h (1-D, > 0): inversion then forward evaluation."""
+        """Full state for approaches h (1-D, 0 < h ≤ ``domain.h_max``): inversion then
+        forward evaluation."""
+        self.check_approach(h)
         a, u = self._invert(h)
         return self.state_at_a(a, u)
 
+    # ------------------------------------------------------------------ domain
+    def check_approach(self, h, name: str = "h") -> None:
+        """ValueError naming ``name``, its largest value and the allowed range if an approach
+        lies beyond the domain (:attr:`domain`); one reduction over h."""
+        h = np.asarray(h, dtype=float)
+        if h.size == 0:
+            return
+        top = float(np.max(h))
+        d = self.domain
+        if top > d.h_max * _DOMAIN_SLACK:
+            raise ValueError(
+                f"{name} = {_num(top)} (approach) is outside the model's domain 0 < h <= "
+                f"{_num(d.h_max)} (h <= 0: no contact); at h = {_num(d.h_max)} {d.bound} "
+                f"({self.describe()})")
+
+    def check_radius(self, a) -> None:
+        """ValueError naming a, its largest value and the allowed range beyond the domain."""
+        a = np.asarray(a, dtype=float)
+        d = self.domain
+        if a.size and float(np.max(a)) > d.a_max * _DOMAIN_SLACK:
+            raise ValueError(
+                f"a = {_num(float(np.max(a)))} (contact radius) is outside the model's domain "
+                f"0 < a <= {_num(d.a_max)}; at a = {_num(d.a_max)} {d.bound} ({self.describe()})")
+
+    @cached_property
+    def domain(self) -> Domain:
+        """The approaches the model accepts (module docstring): up to the first deformable
+        sphere's own approach reaching its radius, h_i = R_i (inf if no sphere is finite)."""
+        own = [(i, s.radius) for i, s in ((1, self.s1), (2, self.s2))
+               if not s.is_rigid and not s.is_flat]
+        if not own:
+            return Domain(math.inf, math.inf, "")
+        i, R = min(own, key=lambda c: c[1])
+        if self.mode in ("rigid1", "rigid2"):  # h_i = h
+            return Domain(R, float(self._invert(np.array([R]))[0][0]), self._own_text(i, R))
+        if self.mode == "equal":  # h_1 = h_2 = h/2
+            return Domain(2.0 * R, float(self._invert(np.array([2.0 * R]))[0][0]), self._own_text(i, R))
+        return self._general_domain(own)
+
+    def _own_ratio(self, a, own) -> np.ndarray:
+        """max_i h_i/R_i over the deformable spheres ``own`` at contact radii a (general mode)."""
+        st = self.state_at_a(a)
+        h_i = {1: st.h1, 2: st.h2}
+        return np.maximum.reduce([h_i[i] / R for i, R in own] + [np.zeros_like(a)])
+
+    def _general_domain(self, own) -> Domain:
+        """The domain of two deformable spheres: the smallest a with max_i h_i/R_i = 1 (a scan
+        in ln a, then :meth:`_refine_crossing`)."""
+        t = math.log(self.R_star) + np.arange(-14.0, 7.0, 0.1)
+        above = np.nonzero(self._own_ratio(np.exp(t), own) >= 1.0)[0]
+        if above.size == 0:
+            return Domain(math.inf, math.inf, "")
+        j = above[0]
+        a = math.exp(self._refine_crossing(t[max(j - 1, 0)], t[j], own))
+        st = self.state_at_a(np.array([a]))
+        h_i = {1: float(st.h1[0]), 2: float(st.h2[0])}
+        k, R = max(own, key=lambda c: h_i[c[0]] / c[1])
+        return Domain(float(st.h[0]), a, self._own_text(k, R))
+
+    def _refine_crossing(self, lo: float, hi: float, own) -> float:
+        """ln a where max_i h_i/R_i first reaches 1 in [lo, hi] (multi-section passes, one
+        vectorised κ solve each); returns the upper end (≥ 1 side)."""
+        frac = np.arange(1, _DOMAIN_SECTIONS) / _DOMAIN_SECTIONS
+        for _ in range(_DOMAIN_PASSES):
+            pts = lo + (hi - lo) * frac
+            k = np.nonzero(self._own_ratio(np.exp(pts), own) >= 1.0)[0]
+            first = k[0] if k.size else frac.size
+            lo = pts[first - 1] if first > 0 else lo
+            hi = pts[first] if first < frac.size else hi
+        return float(hi)
+
+    @staticmethod
+    def _own_text(i: int, R: float) -> str:
+        return (f"the approach of sphere {i} reaches its radius, h_{i} = R_{i} = {_num(R)} "
+                "(the hemisphere is flattened completely)")
+
+
+def pair(s1: Sphere, s2: Sphere, coeffs: Coefficients | None = None) -> UnifiedPair:
+    """Cached :class:`UnifiedPair` (spheres and coefficient sets are hashable). Keyed by the
+    calibrated range too: it sets where the fitted terms are continued (``levels.py``), and
+    coefficient sets that differ only in provenance compare equal."""
+    co = default_coefficients() if coeffs is None else coeffs
+    return _cached_pair(s1, s2, co, co.calibrated_range)
+
 
 @lru_cache(maxsize=256)
-def pair(s1: Sphere, s2: Sphere, coeffs: Coefficients | None = None) -> UnifiedPair:
-    """Cached :class:`UnifiedPair` (spheres and coefficient sets are hashable)."""
+def _cached_pair(s1: Sphere, s2: Sphere, coeffs: Coefficients, rng) -> UnifiedPair:
     return UnifiedPair(s1, s2, coeffs)

@@ -22,8 +22,11 @@ from spherecontact.model.coefficients import Coefficients
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED_DB = ROOT / "data" / "reference.h5"
 SHIPPED = ROOT / "data" / "coefficients.json"
-#: the keys ``model/`` reads, in this shape
-KEYS = {"E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "Lambda"}
+#: the keys ``model/`` reads, in this shape (written by calibration)
+KEYS = {"E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "Lambda",
+        "K_over_sigma_y", "R_over_R_rigid"}
+#: the keys files written before the hardening magnitude and the scene axis were recorded have
+OLD_KEYS = KEYS - {"K_over_sigma_y", "R_over_R_rigid"}
 
 
 def _expected(ds, beta) -> dict:
@@ -35,12 +38,17 @@ def _expected(ds, beta) -> dict:
             "hardening_n": [min(m.n if m.K > 0 else 0.0 for m in mats),
                             max(m.n if m.K > 0 else 0.0 for m in mats)],
             "h_over_R_max": float(ds.h_R.max()), "a_over_R_max": float(ds.x_R.max()),
-            "Lambda": [float(lam.min()), float(lam.max())]}
+            "Lambda": [float(lam.min()), float(lam.max())],
+            "K_over_sigma_y": [min(m.K / m.sigma_y for m in mats), max(m.K / m.sigma_y for m in mats)],
+            "R_over_R_rigid": [min(c.radius / c.indenter_radius for c in ds.curves),
+                               max(c.radius / c.indenter_radius for c in ds.curves)]}
 
 
-def _assert_matches(block: dict, expected: dict) -> None:
-    assert set(block) == KEYS
+def _assert_matches(block: dict, expected: dict, older_file_ok: bool = False) -> None:
+    assert set(block) in ((KEYS, OLD_KEYS) if older_file_ok else (KEYS,))
     for key, want in expected.items():
+        if key not in block:
+            continue
         got = block[key]
         if isinstance(want, list):
             assert isinstance(got, list) and len(got) == 2, key
@@ -68,6 +76,8 @@ def test_calibrated_range_is_written_and_matches_the_runs():
     assert block["E_over_sigma_y"] == [10.0, 10000.0]
     assert block["nu"] == [0.3, 0.3]
     assert block["hardening_n"] == [0.0, 0.5]
+    assert block["K_over_sigma_y"] == [0.0, 2.0]        # perfectly plastic and K/σY = 2
+    assert block["R_over_R_rigid"] == [0.0, 1.0]        # rigid flat and rigid sphere of radius R
     assert block["h_over_R_max"] == pytest.approx(max(float(r.h[-1]) / r.inputs["radius"]
                                                       for _, r in runs), rel=1e-6)
     Coefficients.from_dict(d)  # the file with its range still loads
@@ -83,6 +93,7 @@ def test_calibrated_range_covers_a_dataset_of_other_runs():
     _assert_matches(block, _expected(ds, KNOWN_CO.beta))
     assert block["nu"] == [0.2, 0.45] and block["hardening_n"] == [0.0, 0.15]
     assert block["E_over_sigma_y"] == [100.0, 1000.0]
+    assert block["K_over_sigma_y"] == [0.0, 2.0] and block["R_over_R_rigid"] == [0.0, 0.0]
 
 
 @pytest.mark.skipif(not SHIPPED_DB.exists(), reason="data/reference.h5 (the FE reference "
@@ -95,4 +106,4 @@ def test_shipped_file_records_the_range_of_its_calibration_runs():
     if source["calibration_runs_hash"] != d["provenance"]["fe_dataset"]["calibration_runs_hash"]:
         pytest.skip("data/coefficients.json was calibrated on other calibration runs")
     ds = build_dataset(runs)
-    _assert_matches(d["provenance"]["calibrated_range"], _expected(ds, d["beta"]))
+    _assert_matches(d["provenance"]["calibrated_range"], _expected(ds, d["beta"]), older_file_ok=True)

@@ -15,6 +15,7 @@ from test_calibration_schema import COLLAPSE, v2
 from spherecontact.calibration import fit as fitmod
 from spherecontact.calibration.forms import CANDIDATES, FORMS, X_C2
 from spherecontact.model import ContactLaw, Material, Sphere, contact, levels
+from spherecontact.model.calibrated_range import DEFAULT_RANGE
 from spherecontact.model.coefficients import Coefficients, CollapseLimit, load_coefficients
 from spherecontact.model.single import BodyLaw
 from spherecontact.model.unified import UnifiedPair
@@ -38,9 +39,22 @@ BEFORE = {
     "dlnc2_dlny": [0.0031153959530151208, -0.018189357810737557, -0.06977635749428647,
                    -0.07909476493751305],
 }
-#: contact() of Sphere(1, HARD) with Sphere(2, E/σY = 100) at h = 1e-3, 0.03, 0.2, same set
+#: contact() of Sphere(1, HARD) with Sphere(2, E/σY = 100) at h = 1e-3, 0.03, 0.2, same set.
+#: Body 2 has the curvature ratio z_2 = R_2 E*/(E'_2 R*) − 1 = 1.5, beyond the default calibrated
+#: z ≤ 1, where the z-terms of the collapse limits are now continued to constants (levels.py):
+#: these numbers hold for a set whose range covers z = 1.5 (``_z_covered``), the default set
+#: gives ``CONTINUED_F``, ``CONTINUED_K``.
 BEFORE_F = [0.0035416949668974477, 0.4283235128640877, 2.468586948384369]
 BEFORE_K = [6.184792990601234, 16.419257857555962, 10.388601035535771]
+CONTINUED_F = [0.0035421038534381214, 0.4279919740293698, 2.460924697535708]
+CONTINUED_K = [6.185707841542298, 16.393051939792855, 10.344408291010966]
+
+
+def _z_covered(co: Coefficients) -> Coefficients:
+    """``co`` with the default calibrated range but R/R_rigid up to 2 (z ≤ 1.5 as fitted)."""
+    d = co.to_dict()
+    d["provenance"]["calibrated_range"] = dict(DEFAULT_RANGE.to_dict(), R_over_R_rigid=[0.0, 2.0])
+    return Coefficients.from_dict(d)
 
 
 def test_new_keys_round_trip(tmp_path):
@@ -68,10 +82,13 @@ def test_file_without_the_new_keys_gives_the_numbers_of_before():
         np.testing.assert_allclose(getattr(r, f), v, rtol=1e-13, atol=1e-15, err_msg=f)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        st = contact(Sphere(1.0, HARD), Sphere(2.0, Material(E=100.0, nu=0.3, sigma_y=1.0)),
-                     np.array([1e-3, 0.03, 0.2]), coeffs=co)
+        pair = Sphere(1.0, HARD), Sphere(2.0, Material(E=100.0, nu=0.3, sigma_y=1.0))
+        st = contact(*pair, np.array([1e-3, 0.03, 0.2]), coeffs=_z_covered(co))
+        default = contact(*pair, np.array([1e-3, 0.03, 0.2]), coeffs=co)
     np.testing.assert_allclose(st.F, BEFORE_F, rtol=1e-12)
     np.testing.assert_allclose(st.stiffness, BEFORE_K, rtol=1e-12)
+    np.testing.assert_allclose(default.F, CONTINUED_F, rtol=1e-12)
+    np.testing.assert_allclose(default.stiffness, CONTINUED_K, rtol=1e-12)
     # writing the keys with their neutral values changes no bit
     explicit = copy.deepcopy(COLLAPSE)
     explicit["H_bar"]["xn_poly"] = []

@@ -22,14 +22,17 @@ from spherecontact.model.coefficients import LITERATURE, Coefficients, default_p
 CO = Coefficients.from_dict(LITERATURE)
 PP = Material(E=200.0, nu=0.3, sigma_y=1.0)                      # E/σ_Y 200, perfectly plastic
 LUD = Material(E=300.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)
-TAB = Material.from_table(E=500.0, nu=0.35, eps_p=[0.0, 0.02, 0.1, 0.5], sigma=[1.0, 1.3, 1.7, 2.0])
+#: a tabulated Ludwik curve σ_Y + 1.5 ε^0.3 (in range: n, K/σ_Y and the local slopes); the table
+#: 1.0, 1.3, 1.7, 2.0 at 0, 0.02, 0.1, 0.5 used before reads as Ludwik K/σ_Y = 3.3 through ε = 0.01, 0.1
+TAB = Material.from_table(E=500.0, nu=0.35, eps_p=[0.0, 0.01, 0.1, 0.5],
+                          sigma=[1.0 + 1.5 * e**0.3 for e in (0.0, 0.01, 0.1, 0.5)])
 FLAT = Sphere(math.inf, Material.rigid())
 H_IN = np.geomspace(1e-5, 0.25, 400)   # h/R inside the calibrated h/R ≤ 0.3 for R = 1
 
 IN_RANGE = {
     "rigid_flat": (Sphere(1.0, PP), FLAT),
     "rigid_flat_table": (Sphere(1.0, TAB), FLAT),
-    "rigid_sphere": (Sphere(1.0, LUD), Sphere(0.5, Material.rigid())),
+    "rigid_sphere": (Sphere(1.0, LUD), Sphere(2.0, Material.rigid())),   # calibrated R_rigid/R: 1 … inf
     "equal": (Sphere(1.0, LUD), Sphere(1.0, LUD)),
     "dissimilar": (Sphere(1.0, PP), Sphere(3.0, Material(E=500.0, nu=0.25, sigma_y=2.5, K=1.0, n=0.2))),
     "deformable_flat": (Sphere(math.inf, PP), Sphere(1.0, LUD)),
@@ -131,11 +134,11 @@ def test_warning_is_a_user_warning_attributed_to_the_caller():
 
 def test_one_warning_per_cause_per_call_not_per_point():
     s1 = Sphere(1.0, Material(E=2.5, nu=0.49, sigma_y=1.0))   # E/σ_Y and ν out
-    h = np.geomspace(1e-5, 2.0, 20000)                           # h/R and a/R out at many points
+    h = np.geomspace(1e-5, 1.0, 20000)                           # h/R and a/R out at many points
     rec = _records(lambda: contact(s1, FLAT, h, CO))
     msgs = sorted(str(w.message).split(" = ")[0] for w in rec)
     assert msgs == ["E/sigma_y", "a/R", "h/R", "nu"]
-    assert "h/R = 2 " in " ".join(str(w.message) for w in rec)   # the largest value is named
+    assert "h/R = 1 " in " ".join(str(w.message) for w in rec)   # the largest value is named
     assert len(_records(lambda: contact(s1, FLAT, h, CO))) == 4  # again on the next call
 
 
@@ -154,7 +157,7 @@ def test_table_warns_once_per_cause_not_per_evaluation():
 
 def test_table_approach_threshold_matches_the_exact_check():
     s1, s2 = Sphere(1.0, PP), Sphere(1.0, PP)    # equal spheres: a reaches R inside the table
-    law = ContactLaw(s1, s2, h_max=3.0, coeffs=CO)
+    law = ContactLaw(s1, s2, h_max=2.0, coeffs=CO)   # the end of the domain: h_i = R_i
     assert law.h_calibrated == pytest.approx(0.6, rel=1e-8)  # each sphere at h/R = 0.3
     h_a = law._pending["a_over_R"][1]          # approach where a/R first reaches 1
     a_exact = contact(s1, s2, np.array([0.99 * h_a, 1.01 * h_a]), CO).a
