@@ -15,6 +15,8 @@ all-quad meshes with guaranteed minimum quality in ~0.05 s.
 
 from __future__ import annotations
 
+import signal
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,13 +78,35 @@ def check_density(density: float) -> float:
     return d
 
 
+#: signals whose disposition gmsh's initialisation changes at the C level behind Python's back
+_KEPT_SIGNALS = (signal.SIGINT, signal.SIGPIPE)
+
+
+def _gmsh_initialize(gmsh) -> None:
+    """``gmsh.initialize`` keeping this process's signal handlers.
+
+    gmsh's C++ initialisation resets SIGPIPE to its default (terminate) and takes SIGINT
+    from Python. A process that later writes to a closed pipe (a dead worker, a reader
+    that went away) would then die silently with status 141 instead of getting
+    BrokenPipeError, and Ctrl-C would kill it without KeyboardInterrupt and the cleanup
+    that goes with it. The Python handlers are put back (main thread only; elsewhere
+    Python cannot set them).
+    """
+    kept = {s: signal.getsignal(s) for s in _KEPT_SIGNALS}
+    gmsh.initialize(interruptible=False)
+    if threading.current_thread() is threading.main_thread():
+        for sig, handler in kept.items():
+            if handler is not None:
+                signal.signal(sig, handler)
+
+
 def _gmsh_quad8(radius: float, density: float, linear: bool, contact_scale: float,
                 edge_band: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """Run gmsh; return node coordinates (2, n) and quad connectivity (n_per_el, n_el)."""
     import gmsh
 
     R, L = radius, contact_scale
-    gmsh.initialize(interruptible=False)
+    _gmsh_initialize(gmsh)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("hemisphere")

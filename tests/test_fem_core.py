@@ -1,6 +1,9 @@
 """FE building blocks: tensor functions, return mapping, tangent, assembly, mesh, contact."""
 
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -115,6 +118,22 @@ def test_mesh_geometry(coarse):
     assert np.allclose(X[1, hm.equator], 1.0) and np.allclose(X[0, hm.axis], 0.0)
     # volume of the hemisphere from the quadrature weights: 2π/3 R³
     assert coarse.weights.sum() == pytest.approx(2 * np.pi / 3, rel=1e-6)
+
+
+def test_meshing_keeps_the_process_signal_handlers():
+    """gmsh's initialisation resets SIGPIPE to terminate: a process that wrote to a closed
+    pipe afterwards died with status 141 instead of getting BrokenPipeError."""
+    script = ("import os\n"
+              "from spherecontact.fem.mesh import build_mesh\n"
+              "build_mesh(1.0, density=0.25)\n"
+              "r, w = os.pipe()\n"
+              "os.close(r)\n"
+              "try:\n"
+              "    os.write(w, b'x')\n"
+              "except BrokenPipeError:\n"
+              "    print('BrokenPipeError')\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() == "BrokenPipeError", (proc.returncode, proc.stderr)
 
 
 @pytest.mark.parametrize("density", [0.1, 5.0, float("nan")])
