@@ -8,6 +8,8 @@ import os as _os
 
 # The fits are small dense problems (hundreds of rows, ~20 columns): BLAS threads only
 # add overhead and contend with other jobs on the machine. Effective when this package
-# is imported before numpy (the command line); the Makefile sets the same variables.
+# is imported before numpy (the command line) and the variables are unset; the Makefile
+# sets the same variables. Whatever they say, ``pipeline.calibrate_runs`` runs with one
+# BLAS thread (``threads.py``): the written file must not depend on them.
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")

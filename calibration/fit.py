@@ -48,7 +48,9 @@ SLOPE_MARGIN = 0.3
 _N_ENDS = np.array([[MONOTONE_N.max()], [0.0]])  # both ends of n (rows), broadcast against x
 #: finite-size factors stay above this on 0 ≤ a/R ≤ 1
 FACTOR_MIN = 0.2
-#: significant digits of the written coefficients
+#: significant digits of the written coefficients: the fewest whose rounding moves the model's
+#: F and a by < 1e-5 (chosen set of the reference database: 3.9e-6 and 1.4e-6 at 6 digits,
+#: 3.7e-5 and 1.6e-5 at 5; calibration/README.md, "Reproducibility")
 SIGNIFICANT = 6
 #: stopping tolerances (relative change of cost and parameters) and the iteration cap of a
 #: solve; tighter values moved the cost by < 0.5 % on the development data and took 3–5× longer

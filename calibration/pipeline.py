@@ -19,6 +19,7 @@ import dataclasses
 import hashlib
 import json
 import math
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,13 +34,20 @@ from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
+from .threads import single_threaded_blas
 from .workers import DEFAULT_WORKERS, Workers
 
 __all__ = ["Calibration", "calibrate_runs", "calibrate", "load_runs", "coefficient_file",
-           "write_json", "cv_score", "calibrated_range"]
+           "write_json", "cv_score", "calibrated_range", "source_path", "STAT_SIGNIFICANT"]
 
 #: relative E_cv margin within which the form with fewer parameters is preferred
 PARSIMONY = 0.02
+
+#: significant digits of the statistics the file records (fit residuals, noise floor,
+#: cross-validation, model error per run; ``calibration/README.md``, "Reproducibility").
+#: They vary by up to 3e-5 relative between machines (1.3e-3 for the E_cv of ``poly``,
+#: whose folds stop at their iteration cap): 4 digits changed 1–5 of them, 3 digits none.
+STAT_SIGNIFICANT = 3
 
 METHOD = ("scipy.optimize.least_squares (trf, bounds) of ln(p_m) and ln(c2), model/FE, on FE "
           "curves resampled uniformly in ln h; form chosen by leave-one-material-out "
@@ -113,12 +121,14 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
                    large_deformation_options: bool = True, source: dict | None = None,
                    workers: int = DEFAULT_WORKERS) -> Calibration:
     """Fit, cross-validate, choose, check. ``runs``: iterable of ``(key, run)``; the
-    independent fits run on ``workers`` processes (the result does not depend on it)."""
+    independent fits run on ``workers`` processes, with one BLAS thread each whatever the
+    environment says (the result depends on neither)."""
     t0 = time.perf_counter()
-    ds = build_dataset(runs)
-    timings = {"dataset_s": time.perf_counter() - t0}
-    with Workers(ds, workers) as pool:
-        cal = _calibrate(ds, pool, candidates, cross_validation, large_deformation_options, timings)
+    with single_threaded_blas():  # the result must not depend on the BLAS thread count (threads.py)
+        ds = build_dataset(runs)
+        timings = {"dataset_s": time.perf_counter() - t0}
+        with Workers(ds, workers) as pool:
+            cal = _calibrate(ds, pool, candidates, cross_validation, large_deformation_options, timings)
     cal.source = dict(source or {})
     timings["total_s"] = time.perf_counter() - t0
     return cal
@@ -200,9 +210,10 @@ def load_runs(db_path, include_stopped: bool = True):
     ``runs`` are ``(key, run)`` pairs of set "calibration": converged runs and, with
     ``include_stopped`` (default), the converged increments of runs that stopped early
     (wall-time limit or increment floor: every stored increment is a converged state,
-    the run just ends before h_max); ``source`` describes the database: path, content hash,
-    the date of the newest run used (the coefficient file's date, so the same database
-    gives the same file), the keys used and those left out with their status.
+    the run just ends before h_max); ``source`` describes the database: path
+    (:func:`source_path`), content hash, the date of the newest run used (the coefficient
+    file's date, so the same database gives the same file), the keys used and those left
+    out with their status.
     Raises FileNotFoundError/ValueError (from the reader) for a missing or unreadable
     file and ValueError if it holds no usable calibration run.
     """
@@ -228,16 +239,31 @@ def load_runs(db_path, include_stopped: bool = True):
         h.update(f"{r.key}\0{r.status}\0".encode())
         for arr in (run.h, run.F, run.a):
             h.update(np.ascontiguousarray(arr, dtype="<f8").tobytes())
-    source = {"path": str(db_path), "content_hash": db.content_hash,
+    source = {"path": source_path(db_path), "content_hash": db.content_hash,
               "calibration_runs_hash": h.hexdigest(), "date": dates[-1][:10] or None,
               "runs": [{"key": r.key, "case": r.case} for r, _ in pairs], "left_out": left_out,
               "partial": partial}
     return [(f"{r.case} [{r.key}]", run) for r, run in pairs], source
 
 
+def source_path(db_path) -> str:
+    """The database path as the file records it: relative to the working directory when the
+    database lies under it (``data/reference.h5`` whether given as that, ``./data/…`` or
+    absolute), with ``/`` separators; otherwise as given."""
+    p = os.path.abspath(os.fspath(db_path))
+    try:
+        return Path(p).relative_to(os.path.abspath(os.getcwd())).as_posix()
+    except ValueError:
+        return Path(os.fspath(db_path)).as_posix()
+
+
+def _stat(x: float) -> float:
+    return round_sig(x, STAT_SIGNIFICANT)
+
+
 def _stats(e) -> dict:
     e = np.asarray(e, dtype=float)
-    return {"rms": round_sig(rms(e), 4), "max": round_sig(float(np.max(np.abs(e))), 4)}
+    return {"rms": _stat(rms(e)), "max": _stat(float(np.max(np.abs(e))))}
 
 
 def _round_out(x: float, up: bool) -> float:
@@ -311,16 +337,16 @@ def coefficient_file(cal: Calibration) -> dict:
                       "(20/3 pole elements)",
         },
         "fit_residuals": {q: _stats(e) for q, e in best.errors.items()},
-        "noise_floor": {"H_bar": round_sig(cal.noise["H_bar"], 3), "c2": round_sig(cal.noise["c2"], 3),
+        "noise_floor": {"H_bar": _stat(cal.noise["H_bar"]), "c2": _stat(cal.noise["c2"]),
                         "note": "RMS scatter of the calibration points about a local cubic in ln h "
                                 "of their own run (leave-one-out, +-0.25 decade): the floor of "
                                 "fit_residuals; systematic FE errors not included"}
         if cal.noise else None,
-        "cross_validation": {n: {q: {k: round_sig(v, 4) for k, v in s.items()}
-                                 for q, s in cv.pooled().items()} | {"score": round_sig(cv_score(cv), 4)}
+        "cross_validation": {n: {q: {k: _stat(v) for k, v in s.items()}
+                                 for q, s in cv.pooled().items()} | {"score": _stat(cv_score(cv))}
                              for n, cv in cal.cv.items()},
-        "model_error_per_run": {e.key: {"F": {"rms": round_sig(e.F_rms, 4), "max": round_sig(e.F_max, 4)},
-                                        "a": {"rms": round_sig(e.a_rms, 4), "max": round_sig(e.a_max, 4)}}
+        "model_error_per_run": {e.key: {"F": {"rms": _stat(e.F_rms), "max": _stat(e.F_max)},
+                                        "a": {"rms": _stat(e.a_rms), "max": _stat(e.a_max)}}
                                 for e in cal.run_errors},
         "model_error_note": "F(h), a(h) of the model in the FE scene against the resampled FE curves "
                             "(relative), a >= a_min",

@@ -39,6 +39,12 @@ Schema 1 files (the literature set) are still read; they have no collapse block.
 
 The input range the set was calibrated on is :attr:`Coefficients.calibrated_range`, read
 from ``provenance["calibrated_range"]`` (``calibrated_range.py``; a default when absent).
+
+Digits: calibration writes every fitted coefficient with 6 significant digits
+(``calibration.fit.SIGNIFICANT``) and the statistics in ``provenance`` with 3
+(``calibration.pipeline.STAT_SIGNIFICANT``); the values are used exactly as read, and the
+residuals the file reports are those of the written set (``calibration/README.md``,
+"Reproducibility").
 """
 
 from __future__ import annotations
