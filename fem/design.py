@@ -132,8 +132,21 @@ OPTION_NAMES = tuple(f.name for f in fields(SolverOptions) if f.name != "max_wal
 #: keys of an entry besides PARAMETERS
 _ENTRY_KEYS = ("options", "cycles", "sample")
 _SETS_RESERVED = ("campaign", "defaults", "flow_curves")
+#: significant digits of a tabulated Voce-type curve. The table is the run's input, hashed
+#: into its key, and NumPy's SIMD exp/log/power differ in the last bit between CPUs (the
+#: keys of campaign v2's 12 Voce runs changed on another machine with the same code and
+#: NumPy); rounded, the same campaign gives the same keys everywhere (a last-bit change
+#: crosses a 10-digit rounding boundary with probability ~1e-6 per value). The rounding
+#: moves the curve by < 5e-11 relative.
+TABLE_DIGITS = 10
+
+
+def _rounded(values) -> np.ndarray:
+    return np.array([float(f"{v:.{TABLE_DIGITS}g}") for v in np.asarray(values, dtype=float)])
+
+
 #: strain points of the table a Voce-type curve is stored as (linear between them)
-VOCE_STRAINS = (0.0, *np.geomspace(1e-5, 4.0, 90))
+VOCE_STRAINS = tuple(_rounded([0.0, *np.geomspace(1e-5, 4.0, 90)]))
 #: space-filling designs of a ``sample`` table (scipy.stats.qmc)
 SAMPLERS = ("sobol", "lhs")
 #: significant digits of a sampled parameter value (readable names, stable keys)
@@ -357,7 +370,7 @@ def _body1(p: dict, curves: dict) -> Material:
         return lud
     eps = np.array(VOCE_STRAINS)
     sig = lud.flow_stress(eps) + p["Q_over_sigma_y"] * sy * -np.expm1(-p["b"] * eps)
-    return Material.from_table(E, p["nu"], eps, sig)
+    return Material.from_table(E, p["nu"], eps, _rounded(sig))
 
 
 def _inputs(p: dict, options: dict, curves: dict | None = None) -> dict:
