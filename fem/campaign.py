@@ -80,9 +80,42 @@ def _progress_writer(case: Case, kwargs: dict):
         if now - last[0] >= 2.0:
             last[0] = now
             tmp = path.with_suffix(".tmp")
-            tmp.write_text(f"{h / h_max:.6g}")
-            tmp.replace(path)
+            try:
+                tmp.write_text(f"{h / h_max:.6g}")
+                tmp.replace(path)
+            except OSError:  # a report that cannot be written must never fail the run
+                pass
     return progress
+
+
+def progress_folder(db_path: Path) -> Path:
+    """This invocation's folder for its workers' reports, ``.<db>.progress.<pid>`` next to the
+    database: two campaigns on one database (e.g. a retry of one case beside the main run)
+    each keep their own, so neither clears the other's."""
+    return db_path.parent / f".{db_path.name}.progress.{os.getpid()}"
+
+
+def remove_stale_progress(db_path: Path) -> list[Path]:
+    """Remove the progress folders of campaigns on ``db_path`` that no longer run (killed);
+    those of live processes stay. Returns the folders removed."""
+    removed = []
+    for folder in db_path.parent.glob(f".{db_path.name}.progress*"):
+        pid = folder.name.rsplit(".", 1)[-1]
+        if pid.isdigit() and _alive(int(pid)):
+            continue
+        shutil.rmtree(folder, ignore_errors=True)
+        removed.append(folder)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
 
 
 def read_progress(folder: Path, cases) -> dict[str, float]:
@@ -331,8 +364,8 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
         elif workers == 0:
             stream = _inline(todo, runner)
         else:  # workers report their runs' h/h_max to a folder next to the database
-            folder = db_path.parent / f".{db_path.name}.progress"
-            shutil.rmtree(folder, ignore_errors=True)  # a killed campaign's reports are stale
+            remove_stale_progress(db_path)  # a killed campaign's reports are stale
+            folder = progress_folder(db_path)
             folder.mkdir()
             stream = _local(todo, runner, min(workers, len(todo)), folder,
                             _running_reporter(bar, folder))

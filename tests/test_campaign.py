@@ -252,7 +252,27 @@ def test_workers_report_progress_and_the_folder_is_removed(tmp_path, monkeypatch
     assert not (tmp_path / "p2").exists()                    # removed when the workers are done
     assert all(isinstance(running, list) for running in seen)
     assert fc.run_campaign(c, db_path, workers=1)["total"]["converged"] == 2
-    assert not (tmp_path / ".ref.h5.progress").exists()
+    assert not list(tmp_path.glob(".ref.h5.progress*"))
+
+
+def test_progress_reports_never_fail_a_run_and_campaigns_keep_their_own(tmp_path, monkeypatch):
+    """A second campaign on the same database (a retry of one case) used to clear the shared
+    progress folder when it finished; every run of the first then failed with
+    FileNotFoundError at its next report (campaign v2: 25 runs lost, one after 400 s)."""
+    c = parse_campaign(tiny('[[calibration]]\nscene = "flat"\nE_over_sigma_y = 100\n'))
+    monkeypatch.setenv(fc.PROGRESS_ENV, str(tmp_path / "gone"))  # the folder does not exist
+    assert fc.execute(c.cases[0]).status == "converged"
+    db_path = tmp_path / "ref.h5"
+    mine = fc.progress_folder(db_path)
+    assert mine.name == f".ref.h5.progress.{os.getpid()}"
+    live = tmp_path / f".ref.h5.progress.{os.getppid()}"  # another campaign that still runs
+    dead_pid = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                              capture_output=True, text=True, check=True).stdout.strip()
+    dead, legacy = tmp_path / f".ref.h5.progress.{dead_pid}", tmp_path / ".ref.h5.progress"
+    for folder in (live, dead, legacy):
+        folder.mkdir()
+    assert sorted(fc.remove_stale_progress(db_path)) == sorted([dead, legacy])
+    assert live.is_dir()
 
 
 def test_remove_entries_rejects_unknown_keys_and_keeps_the_rest(tmp_path):
