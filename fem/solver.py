@@ -18,6 +18,7 @@ the converged part kept and flagged.
 
 from __future__ import annotations
 
+import copy
 import time
 from dataclasses import dataclass, field
 
@@ -356,6 +357,12 @@ def cycles_as_arrays(cycles: list[dict], n_surface: int) -> dict:
     return out if cycles else {}
 
 
+#: most loading increments a run may undo (:meth:`CycleLegs._back_up`), and the step it then
+#: takes from the state before, as a fraction of the undone step
+MAX_BACK_UPS = 10
+BACK_UP_STEP = 0.3
+
+
 @dataclass
 class _RunState:
     """The state an incremental run carries from one converged increment to the next."""
@@ -440,9 +447,35 @@ class CycleLegs:
             return False
         return True
 
+    def _snapshot(self, run: _RunState, dh: float) -> tuple:
+        """The run before an increment of ``dh`` is committed (for :meth:`_back_up`)."""
+        return copy.copy(run), {k: len(v) for k, v in vars(self._hist).items() if isinstance(v, list)}, dh
+
+    def _back_up(self, run: _RunState, before: tuple | None) -> bool:
+        """Undo the last loading increment when every step from it has failed down to dh_min,
+        and go on from the state before it with a step of ``BACK_UP_STEP`` × the undone one.
+
+        A converged increment can end in a state Newton cannot leave: campaign v2, rigid sphere
+        R2/R1 = 2.07, K/σY = 6.2, n = 0.149 (the flow stress rises by 1.6 σY within ε_p = 1e-4)
+        converged to h/R = 6.3e-4 with its contact edge node flipping, frozen closed with a
+        reaction of −4.2 % of F, and from there every increment failed down to dh_min. At most
+        ``MAX_BACK_UPS`` per run; counted in ``timings["backed_up_increments"]``.
+        """
+        if before is None or self.backed_up_increments >= MAX_BACK_UPS:
+            return False
+        saved, lengths, dh = before
+        vars(run).update(vars(saved))
+        hist = vars(self._hist)
+        for key, n in lengths.items():
+            del hist[key][n:]
+        run.dh = BACK_UP_STEP * dh
+        self.backed_up_increments += 1
+        return True
+
     def _load_leg(self, run: _RunState, peak: float, targets=None) -> bool:
         """Load (elastic reloading first, below the largest approach reached) up to ``peak``."""
         opt, R = self.options, self._length
+        before = None  # the run before the last loading increment (_back_up)
         while run.h < peak * (1 - 1e-12):
             if self._out_of_time(run):
                 return False
@@ -461,12 +494,16 @@ class CycleLegs:
             solved = self._solve(run, run.h + dh)
             if isinstance(solved, Exception):
                 if not self._cut_back(run, dh, solved):
+                    if branch == LOAD and self._back_up(run, before):
+                        before = None
+                        continue
                     return False
                 if branch == RELOAD:
                     run.dh_cycle *= 0.5
                 else:
                     run.dh *= 0.5
                 continue
+            before = self._snapshot(run, dh) if branch == LOAD else None
             self._commit(run, run.h + dh, solved, branch)
             if branch == LOAD:
                 if targets is not None:
@@ -927,6 +964,7 @@ class IndentationSolver(CycleLegs):
         self.linear = SymmetricSolver(opt.linear_solver)
         self.rejected = []
         self.plastic_frozen_increments = 0
+        self.backed_up_increments = 0
         hist = History()
         self._hist, self._progress = hist, progress
         targets = None
@@ -954,6 +992,7 @@ class IndentationSolver(CycleLegs):
                    "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum()),
                    "rejected_increments": len(self.rejected),
                    "plastic_frozen_increments": self.plastic_frozen_increments,
+                   "backed_up_increments": self.backed_up_increments,
                    **{f"linear_{k}": v for k, v in self.linear.stats.items()}}
         final = {"X": self.X, "u": u, "cells": self.disc.basis.element_dofs.T.copy(),
                  "eps_p": state.eps_p.reshape(self.disc.n_elements, self.disc.n_qp)}

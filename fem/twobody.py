@@ -506,6 +506,7 @@ class TwoBodySolver(CycleLegs):
         self.linear = SymmetricSolver(self.options.linear_solver)
         self.rejected = []
         self.plastic_frozen_increments = 0
+        self.backed_up_increments = 0
         run = _RunState(t_start=time.perf_counter(), u=np.zeros(self.n_dofs),
                         state=[PlasticState.virgin(b.disc.n_elements * b.disc.n_qp) for b in self.bodies],
                         active=np.zeros(self.candidates.size, dtype=bool), dh=opt.dh_first * R)
@@ -611,7 +612,8 @@ class TwoBodySolver(CycleLegs):
                    **{f"linear_{k}": v for k, v in self.linear.stats.items()},
                    "increments": int(curves["h"].size), "newton_iterations": int(curves["iterations"].sum()),
                    "rejected_increments": len(self.rejected),
-                   "plastic_frozen_increments": self.plastic_frozen_increments}
+                   "plastic_frozen_increments": self.plastic_frozen_increments,
+                   "backed_up_increments": self.backed_up_increments}
         b1, b2 = self.bodies
         inputs = {"scene": "two_body", "material": b1.material.describe(), "radius": b1.radius,
                   "material2": b2.material.describe(), "radius2": b2.radius,

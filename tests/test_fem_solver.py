@@ -167,3 +167,18 @@ def test_points_toggling_at_yield_in_a_two_cycle_are_kept_elastic():
     kept = stress_update(F, state.cp_inv, state.eps_p, mat, elastic=np.array([True]))
     assert free.dgamma[0] > 0 and kept.dgamma[0] == 0.0
     assert abs(kept.P[3, 0]) > abs(free.P[3, 0])  # the frozen point's stress stays above yield
+
+
+def test_a_dead_end_increment_is_undone_and_the_run_goes_on(monkeypatch):
+    """Campaign v2, rigid sphere R2/R1 = 2.07, Ludwik K/σY = 6.2, n = 0.149 on the band mesh:
+    the increment to h/R = 6.3e-4 converges with its contact edge frozen, and every step from
+    there fails down to dh_min. The run undoes that increment and steps on from the one before."""
+    import spherecontact.fem.solver as solver_module
+
+    mat = Material(E=963.0, nu=0.3, sigma_y=1.0, K=6.2, n=0.149)
+    res = IndentationSolver(mat, 1.0, RigidObstacle(2.07), edge_band=0.03).run(1e-3)
+    assert res.status == "converged" and res.timings["backed_up_increments"] >= 1
+    assert np.all(np.diff(res.h) > 0)  # the undone increment left no trace in the curves
+    monkeypatch.setattr(solver_module, "MAX_BACK_UPS", 0)
+    stuck = IndentationSolver(mat, 1.0, RigidObstacle(2.07), edge_band=0.03).run(1e-3)
+    assert stuck.status == "stopped" and "dh_min" in stuck.reason and stuck.h[-1] < 7e-4
