@@ -22,7 +22,7 @@ from ..model.material import Material
 from .assembly import ELEMENTS
 from .io import SCENES, check_inputs, run_indentation, write_run
 from .mesh import DENSITY_RANGE
-from .solver import SolverOptions
+from .solver import PENALTY_SCALES, SolverOptions
 
 __all__ = ["register", "run_command", "render_command", "read_flow_table", "material_from_args",
            "options_from_args", "EXIT_STOPPED"]
@@ -106,13 +106,14 @@ def material2_from_args(args: argparse.Namespace, material: Material) -> Materia
 
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
     """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
-    --strain-increment, --max-wall-s, --no-line-search, --penalty, --segment-points and
-    --linear-solver."""
+    --strain-increment, --max-wall-s, --no-line-search, --penalty, --segment-points,
+    --penalty-scale and --linear-solver."""
     return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
                          max_iterations=args.max_iterations, tol=args.tol,
                          strain_increment=args.strain_increment, max_wall_s=args.max_wall_s,
                          line_search=not args.no_line_search, penalty=args.penalty,
-                         segment_points=args.segment_points, linear_solver=args.linear_solver)
+                         segment_points=args.segment_points, penalty_scale=args.penalty_scale,
+                         linear_solver=args.linear_solver)
 
 
 def _check_output(out) -> Path:
@@ -283,6 +284,12 @@ def _add_numerics(add) -> None:
     add(grp, "--segment-points", type=int, default=0,
         help="with --penalty (one body on a rigid flat or sphere): integrate the contact pressure "
              "at this many Gauss points per surface edge, 1-64 (default 0: at the nodes)")
+    add(grp, "--penalty-scale", choices=PENALTY_SCALES, default=_DEFAULTS.penalty_scale,
+        help="with --penalty (one body): 'modulus' (default), stiffness penalty * E / (pole "
+             "element length); 'approach', stiffness penalty * p_m / h, so the obstacle presses "
+             "in by about h / penalty at every approach (use with --segment-points; README, "
+             "'Smoothness of F'). With penalty contact the curve h is the body's own shortening "
+             "and h_applied the obstacle's travel")
     add(grp, "--linear-solver", choices=("ldl", "superlu"), default="ldl",
         help="sparse factorisation: 'ldl' (qdldl LDL^T reusing its ordering, SuperLU where it "
              "fails; default) or 'superlu'")

@@ -111,6 +111,8 @@ CURVES = {
     "dissipation": ("energy", "plastic dissipation"),
     "iterations": ("count", "Newton iterations of the increment"),
     "active_changes": ("count", "contact active-set changes in the increment"),
+    "h_applied": ("length", "penalty contact: travel of the obstacle, h plus the pole's penetration"),
+    "penetration": ("length", "penalty contact: largest penetration of the obstacle"),
     "h1": ("length", "approach of body 1: shortening of its equator-to-pole distance"),
     "h2": ("length", "approach of body 2 (0 for a rigid partner); h = h1 + h2"),
     "interface_curvature": ("1/length", "curvature of the deformed interface at the axis "

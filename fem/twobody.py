@@ -242,6 +242,9 @@ class TwoBodySolver(CycleLegs):
         self.slave = self.bodies[self.slave_index]
         self.master = self.bodies[1 - self.slave_index]
         self.k_penalty = None
+        if self.options.penalty_scale != "modulus":
+            raise ValueError(f"two deformable bodies take penalty_scale 'modulus' only, got "
+                             f"{self.options.penalty_scale!r}")
         if self.options.penalty is None:
             self.passes = [ContactPass(self.slave, self.master, self.n_dofs)]
         else:

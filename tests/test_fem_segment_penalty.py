@@ -83,3 +83,58 @@ def test_edge_band_keeps_the_surface_size_proportional_to_the_distance_from_the_
     assert m.surface.size > 1.5 * plain.surface.size
     with pytest.raises(ValueError, match="edge_band"):
         build_mesh(1.0, 1.0, edge_band=-0.1)
+
+
+# --------------------------------------------------------------- penalty scaled with the approach
+def _flat_run(E: float, h_max: float, **options):
+    from spherecontact.fem.solver import IndentationSolver
+    from spherecontact.model.material import Material
+
+    solver = IndentationSolver(Material(E=E, nu=0.3, sigma_y=1.0), 1.0, RigidObstacle(),
+                               options=SolverOptions(**options))
+    return solver.run(h_max)
+
+
+def test_approach_scaled_penalty_presses_in_about_h_over_P_and_h_is_the_body_shortening():
+    """k_N = P p_m / h: the obstacle presses into the body by about h/P at every approach; the
+    stored h is the equator-to-pole shortening (h_applied − pole penetration), and F(h) stays on
+    the exact contact's curve."""
+    P = 300.0
+    soft = _flat_run(1000.0, 2e-3, penalty=P, segment_points=8, penalty_scale="approach")
+    exact = _flat_run(1000.0, 2e-3)
+    c = soft.curves
+    assert soft.status == "converged" and np.all(np.diff(c["h"]) > 0)
+    sunk = c["h_applied"] - c["h"]  # the pole's penetration
+    late = c["h_applied"] > 5e-4
+    assert np.all(sunk[late] > 0.2 * c["h_applied"][late] / P)
+    assert np.all(c["penetration"][late] < 3.0 * c["h_applied"][late] / P)
+    F_exact = np.interp(c["h"][-1], exact.h, exact.F)
+    assert c["F"][-1] == pytest.approx(F_exact, rel=0.015)  # within the exact run's node steps
+
+
+def test_penalty_scale_is_checked():
+    with pytest.raises(ValueError, match="penalty_scale must be one of"):
+        SolverOptions(penalty=1.0, penalty_scale="pressure").validate()
+    with pytest.raises(ValueError, match="needs penalty contact"):
+        SolverOptions(penalty_scale="approach").validate()
+
+
+def test_two_bodies_refuse_the_approach_scaled_penalty():
+    from spherecontact.fem.twobody import TwoBodySolver
+    from spherecontact.model.material import Material
+
+    m = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    with pytest.raises(ValueError, match="penalty_scale 'modulus' only"):
+        TwoBodySolver(m, 1.0, m, 2.0, options=SolverOptions(penalty=1.0, penalty_scale="approach"))
+
+
+def test_loading_steps_keep_the_strain_increment_from_the_first_one_on():
+    """dh ≤ strain_increment · a of the increment before, and the first step ≤ strain_increment² R
+    (its own Hertz radius √(R dh) obeys the same bound): a step of dh_first = 2e-4 R alone crosses
+    the elastic–plastic transition of E/σY = 1000 (first yield at h/R ≈ 5e-6)."""
+    res = _flat_run(1000.0, 1e-3)
+    c = res.curves
+    eps = SolverOptions().strain_increment
+    assert c["h"][0] <= eps**2 * (1 + 1e-9)
+    dh = np.diff(c["h"])
+    assert np.all(dh <= eps * c["a_nodes"][:-1] * (1 + 1e-9))

@@ -170,15 +170,29 @@ def test_points_toggling_at_yield_in_a_two_cycle_are_kept_elastic():
 
 
 def test_a_dead_end_increment_is_undone_and_the_run_goes_on(monkeypatch):
-    """Campaign v2, rigid sphere R2/R1 = 2.07, Ludwik K/σY = 6.2, n = 0.149 on the band mesh:
-    the increment to h/R = 6.3e-4 converges with its contact edge frozen, and every step from
-    there fails down to dh_min. The run undoes that increment and steps on from the one before."""
+    """A converged increment can end in a state no step leaves (campaign v2, rigid sphere
+    R2/R1 = 2.07, Ludwik K/σY = 6.2, n = 0.149 on the band mesh: the increment to h/R = 6.3e-4
+    converged with its contact edge frozen, and every step from there failed down to dh_min).
+    Here every step from the fifth increment fails until one increment has been undone: the
+    run undoes it and steps on from the one before; without back-ups it stops."""
     import spherecontact.fem.solver as solver_module
+    from spherecontact.fem.solver import IncrementFailed
 
-    mat = Material(E=963.0, nu=0.3, sigma_y=1.0, K=6.2, n=0.149)
-    res = IndentationSolver(mat, 1.0, RigidObstacle(2.07), edge_band=0.03).run(1e-3)
-    assert res.status == "converged" and res.timings["backed_up_increments"] >= 1
+    solve = IndentationSolver._solve
+
+    def trapped(self, run, h_new):
+        if len(self._hist.h) == 5 and self.backed_up_increments == 0:
+            err = IncrementFailed("trapped (test)")
+            self.rejected.append((h_new, h_new - run.h, str(err)))
+            return err
+        return solve(self, run, h_new)
+
+    monkeypatch.setattr(IndentationSolver, "_solve", trapped)
+    mat = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    res = IndentationSolver(mat, 1.0, RigidObstacle()).run(1e-3)
+    assert res.status == "converged" and res.timings["backed_up_increments"] == 1
     assert np.all(np.diff(res.h) > 0)  # the undone increment left no trace in the curves
+    assert len(res.residuals) == res.h.size
     monkeypatch.setattr(solver_module, "MAX_BACK_UPS", 0)
-    stuck = IndentationSolver(mat, 1.0, RigidObstacle(2.07), edge_band=0.03).run(1e-3)
-    assert stuck.status == "stopped" and "dh_min" in stuck.reason and stuck.h[-1] < 7e-4
+    stuck = IndentationSolver(mat, 1.0, RigidObstacle()).run(1e-3)
+    assert stuck.status == "stopped" and "dh_min" in stuck.reason and stuck.h.size == 5
