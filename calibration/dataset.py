@@ -147,7 +147,9 @@ def run_curve(key: str, run, per_decade: int = PER_DECADE,
     rho = relative_radius(R, Ri)
     h, F, a = (np.asarray(v, dtype=float) for v in (run.h, run.F, run.a))
     ok = (h > 0) & (F > 0) & (a > 0) & np.isfinite(h + F + a)
-    loading = getattr(run, "loading", None)  # runs with unloading cycles: the loading curve only
+    # runs with unloading cycles: the loading curve only; without an oversized first step's
+    # transient (``fem.io.reference_mask``)
+    loading = getattr(run, "reference", getattr(run, "loading", None))
     if loading is not None:
         ok &= np.asarray(loading, dtype=bool)
     h, F, a = h[ok], F[ok], a[ok]

@@ -207,7 +207,9 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
 def load_runs(db_path, include_stopped: bool = True):
     """Calibration runs of the database: ``(runs, source)``.
 
-    ``runs`` are ``(key, run)`` pairs of set "calibration": converged runs and, with
+    ``runs`` are ``(key, run)`` pairs of set "calibration" with one deformable body (scenes
+    flat and rigid sphere; two-body runs, whose h = h₁ + h₂ includes the deformable
+    partner's share, are left out and listed): converged runs and, with
     ``include_stopped`` (default), the converged increments of runs that stopped early
     (wall-time limit or increment floor: every stored increment is a converged state,
     the run just ends before h_max); ``source`` describes the database: path
@@ -224,12 +226,16 @@ def load_runs(db_path, include_stopped: bool = True):
     if include_stopped:
         pairs += db.runs(set="calibration", status="stopped")
         pairs.sort(key=lambda p: (p[0].case, p[0].key))
+    # single-body relations only: a two-body run's h = h1 + h2 includes the partner's share
+    pairs = [p for p in pairs if p[0].inputs.get("scene") != "two_body"]
     if not pairs:
         n_all = len(db.records(set="calibration"))
         raise ValueError(f"{db_path}: no converged calibration runs ({n_all} calibration entries, "
                          f"{len(db)} entries in all)")
     used = {r.key for r, _ in pairs}
-    left_out = [{"key": r.key, "case": r.case, "status": r.status, "reason": r.reason}
+    left_out = [{"key": r.key, "case": r.case, "status": r.status,
+                 "reason": ("two bodies (single-body fit)" if r.inputs.get("scene") == "two_body"
+                            else r.reason)}
                 for r in db.records(set="calibration") if r.key not in used]
     dates = sorted(str(run.provenance.get("date_utc", "")) for _, run in pairs)
     partial = [{"key": r.key, "case": r.case, "h_last": float(run.h.max()), "reason": r.reason}

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.io import loading_mask, material_from_description
+from ..fem.io import loading_mask, material_from_description, reference_mask
 from ..model import Material, Sphere
 
 __all__ = [
@@ -77,8 +77,15 @@ class Case:
         return loading_mask(self.curves)
 
     @property
+    def reference(self) -> np.ndarray:
+        """Mask of the loading increments that are a reference: without the transient of an
+        oversized first step (``fem.io.reference_mask``)."""
+        return reference_mask(self.curves, self.inputs)
+
+    @property
     def h(self) -> np.ndarray:
-        """Approach on the loading curve (unloading and reloading increments left out)."""
+        """Approach on the loading curve (unloading and reloading increments and the transient
+        of an oversized first step left out)."""
         return self.curve("h")
 
     @property
@@ -90,10 +97,11 @@ class Case:
         return self.curve("a")
 
     def curve(self, name: str) -> np.ndarray | None:
-        """A recorded curve on the loading increments, or None when the run does not hold it
-        (``raw_curve``: every increment, loading, unloading and reloading)."""
+        """A recorded curve on the reference loading increments (:attr:`reference`), or None
+        when the run does not hold it (``raw_curve``: every increment, loading, unloading and
+        reloading)."""
         c = self.raw_curve(name)
-        return None if c is None else c[self.loading]
+        return None if c is None else c[self.reference]
 
     def raw_curve(self, name: str) -> np.ndarray | None:
         """A recorded curve at every increment in the order computed, or None."""
