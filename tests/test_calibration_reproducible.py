@@ -49,7 +49,7 @@ def test_blas_threads_are_one_inside_the_calibration_and_restored_after():
 
 
 @needs_blas_control
-@pytest.mark.skipif(not SHIPPED_DB.exists(), reason="data/reference.h5 (the FE reference database) "
+@pytest.mark.skipif(not SHIPPED_DB.exists(), reason="data/reference_v2.h5 (the FE reference database) "
                     "is not present")
 def test_coefficients_do_not_depend_on_the_blas_threads_set_before_calibrating():
     """With two OpenBLAS threads the fits' products and factorisations sum in another

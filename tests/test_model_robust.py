@@ -10,8 +10,10 @@
 """
 
 import copy
+import json
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -45,6 +47,7 @@ from spherecontact.model.single import BodyLaw, hardening_magnitude
 from spherecontact.model.unified import UnifiedPair, pair
 
 CO = default_coefficients()
+SHIPPED_FILE = Path(__file__).resolve().parents[1] / "data" / "coefficients.json"
 RIGID = Material.rigid()
 FLAT = Sphere(math.inf, RIGID)
 EPS = np.linspace(0.0, 2.0, 41)
@@ -99,21 +102,21 @@ def test_approach_beyond_the_sphere_raises_naming_h_and_the_range():
 
 
 def test_hardening_magnitude_outside_the_calibrated_range_warns():
-    s1 = Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=1.0, K=5.0, n=0.3))
+    s1 = Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=1.0, K=12.0, n=0.3))
     with pytest.warns(CalibrationRangeWarning,
-                      match=r"hardening magnitude K/sigma_y = 5 of sphere 1 is outside the calibrated "
-                            r"range \[0, 2\]"):
+                      match=r"hardening magnitude K/sigma_y = 12 of sphere 1 is outside the calibrated "
+                            r"range \[0, 10\]"):
         contact(s1, FLAT, [0.1])
 
 
 @pytest.mark.parametrize("order", ["rigid second", "rigid first"])
 def test_small_rigid_indenter_warns_with_its_radius_ratio(order):
     body = Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3))
-    tip = Sphere(0.4, RIGID)
+    tip = Sphere(0.2, RIGID)
     s1, s2, i, j = (body, tip, 1, 2) if order == "rigid second" else (tip, body, 2, 1)
     with pytest.warns(CalibrationRangeWarning,
-                      match=rf"radius ratio R_rigid/R = 0\.4 of rigid sphere {j} over sphere {i} is "
-                            r"outside the calibrated range \[1, inf\]"):
+                      match=rf"radius ratio R_rigid/R = 0\.2 of rigid sphere {j} over sphere {i} is "
+                            r"outside the calibrated range \[0\.25, inf\]"):
         contact(s1, s2, [0.05])
 
 
@@ -295,8 +298,12 @@ def test_continuation_is_C1_with_exact_slopes_and_bounded():
     poly = CO.finite_size_H_bar
     f, s = levels.finite_size_factor(np.array([1.0, 10.0, 1e6]), poly, xm)
     assert np.all(f > 0.0) and abs(s[-1]) < 1e-5
-    raw, _ = levels.finite_size_factor(np.array([10.0]), poly)
-    assert raw[0] < 0.0   # the polynomial itself turns negative there
+    # a polynomial that turns negative beyond the fitted ratio is continued positive
+    falling = (0.2, -0.9)
+    raw, _ = levels.finite_size_factor(np.array([10.0]), falling)
+    assert raw[0] < 0.0
+    f, s = levels.finite_size_factor(np.array([xm, 1.0, 10.0, 1e6]), falling, xm)
+    assert np.all(f > 0.0) and abs(s[-1]) < 1e-5
 
 
 def test_collapse_limit_z_terms_are_continued_beyond_the_fitted_curvature():
@@ -350,8 +357,10 @@ def test_older_file_without_the_new_axes_uses_the_v1_design_values():
     assert DEFAULT_RANGE.K_over_sigma_y == (0.0, 2.0)
     nulls = _lit_with(dict(BLOCK, K_over_sigma_y=None, R_over_R_rigid=None)).calibrated_range
     assert nulls == old
-    # the shipped file predates the keys: it is read, and both axes are checked
-    assert CO.calibrated_range.K_over_sigma_y == (0.0, 2.0)
+    # the shipped file records both axes of its calibration runs, and they are read
+    shipped = json.loads(SHIPPED_FILE.read_text())["provenance"]["calibrated_range"]
+    assert CO.calibrated_range.K_over_sigma_y == tuple(shipped["K_over_sigma_y"])
+    assert CO.calibrated_range.R_over_R_rigid == tuple(shipped["R_over_R_rigid"])
     new = _lit_with(dict(BLOCK, K_over_sigma_y=[0.0, 6.0], R_over_R_rigid=[0.0, 3.0])).calibrated_range
     assert new.K_over_sigma_y == (0.0, 6.0) and new.R_over_R_rigid == (0.0, 3.0)
     assert CalibratedRange.from_provenance({"calibrated_range": new.to_dict()}) == new

@@ -230,8 +230,7 @@ def _result(case: Case):
     """A RunResult holding a case's curves (the fixture database stores real run groups)."""
     from spherecontact.fem.solver import RunResult
 
-    h = case.h
-    n = h.size
+    n = case.raw_curve("h").size   # every increment (case.h leaves the start transient out)
     curves = {k: np.asarray(v, float) for k, v in case.curves.items()}
     F, a = curves["F"], curves["a"]
     curves.update(F_support=F.copy(), a_nodes=a.copy(), a_ref=a.copy(), p_m=F / (np.pi * a**2),

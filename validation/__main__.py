@@ -1,6 +1,6 @@
 """``python -m spherecontact.validation``: the validation report from the reference database.
 
-    python -m spherecontact.validation --db data/reference.h5 \\
+    python -m spherecontact.validation --db data/reference_v2.h5 \\
         --coefficients data/coefficients.json --thresholds validation/thresholds.toml \\
         --out reports/validation
 
@@ -21,7 +21,7 @@ from pathlib import Path
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="python -m spherecontact.validation",
                                 description=__doc__.splitlines()[0])
-    p.add_argument("--db", default="data/reference.h5", help="reference database (HDF5)")
+    p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
     p.add_argument("--coefficients", default=None,
                    help="model coefficient file (default: the model's default, data/coefficients.json)")
     p.add_argument("--thresholds", default="validation/thresholds.toml", help="thresholds (TOML)")
