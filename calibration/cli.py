@@ -63,6 +63,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"calibrate: {len(cal.dataset.curves)} runs, {cal.dataset.size} points; form "
           f"'{cal.chosen}'; RMS H_bar {100 * s['H_bar']['rms']:.2f} % (max {100 * s['H_bar']['max']:.2f} %), "
           f"RMS c2 {100 * s['c2']['rms']:.2f} % (max {100 * s['c2']['max']:.2f} %); "
+          f"F(h) {100 * s['F']['rms']:.2f} % (max {100 * s['F']['max']:.2f} %), "
+          f"a(h) {100 * s['a']['rms']:.2f} % (max {100 * s['a']['max']:.2f} %); "
           f"{time.perf_counter() - t0:.1f} s")
     print(f"calibrate: wrote {args.out}" + (f" and {args.report}/index.md" if args.report else ""))
     return 0

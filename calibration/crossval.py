@@ -52,7 +52,7 @@ class CVResult:
     def pooled(self) -> dict[str, dict[str, float]]:
         """RMS and max |error| over all held-out points, per quantity."""
         out = {}
-        for q in ("H_bar", "c2"):
+        for q in ("H_bar", "c2", "F", "a"):
             e = np.concatenate([f.errors[q] for f in self.folds])
             out[q] = {"rms": rms(e), "max": float(np.max(np.abs(e)))}
         return out

@@ -191,6 +191,8 @@ class Dataset:
     x_R: np.ndarray    # a/R
     x_rho: np.ndarray  # a/ρ
     h_R: np.ndarray    # h/R
+    slope_F: np.ndarray  # d ln F/d ln h of the FE curve (errors at fixed h, ``fit.errors``)
+    slope_a: np.ndarray  # d ln a/d ln h
     cache: dict = field(default_factory=dict, repr=False, compare=False)  # derived per-point arrays
 
     @property
@@ -229,7 +231,13 @@ def build_dataset_from_curves(curves: Iterable[RunCurve]) -> Dataset:
     Ep = cat(lambda c: np.full(c.h.size, c.material.E_prime))
     return Dataset(curves=curves, run=run, h=h, F=F, a=a, rho=rho, R=R, E_prime=Ep,
                    p_m=F / (math.pi * a * a), c2=a * a / (2.0 * h * rho), x_R=a / R, x_rho=a / rho,
-                   h_R=h / R)
+                   h_R=h / R, slope_F=cat(lambda c: _log_slope(c.h, c.F)),
+                   slope_a=cat(lambda c: _log_slope(c.h, c.a)))
+
+
+def _log_slope(h: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """d ln y/d ln h on a run's grid (second-order differences, one-sided at the ends)."""
+    return np.gradient(np.log(y), np.log(h))
 
 
 def build_dataset(runs: Iterable[tuple[str, object]], per_decade: int = PER_DECADE,
@@ -243,15 +251,16 @@ def build_dataset(runs: Iterable[tuple[str, object]], per_decade: int = PER_DECA
     return build_dataset_from_curves(curves)
 
 
-def quantities(ds: Dataset, beta: float) -> dict[str, np.ndarray]:
-    """σ_rep, Λ and H̄ of every point for the representative-strain factor β.
+def quantities(ds: Dataset, beta: float, growth: float = 0.0) -> dict[str, np.ndarray]:
+    """σ_rep, Λ and H̄ of every point for the representative strain ε_rep = β x (1 + γ x),
+    x = a/ρ (β: ``beta``, γ: ``growth``; ``model.single.representative_strain``).
 
     Returns
     -------
     dict with ``sigma_rep``, ``Lambda``, ``H_bar`` (NaN-free; elastic runs have
     σ_rep = inf, Λ = 0 and H̄ = 0) and ``eps_rep``.
     """
-    eps = beta * ds.x_rho
+    eps = beta * ds.x_rho * (1.0 + growth * ds.x_rho)
     sig = np.empty_like(eps)
     for i, c in enumerate(ds.curves):
         m = ds.run == i

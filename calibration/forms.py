@@ -64,6 +64,7 @@ class Form:
     ratio: str = "a_over_R"     # finite-size ratio
     eps_lo: float = 0.01        # secant of the effective hardening exponent
     eps_hi: float = 0.1
+    strain_growth: bool = False  # ε_rep = β x (1 + γ x) with γ fitted (else γ = 0)
 
     # ------------------------------------------------------------------ parameters
     def parameters(self) -> list[tuple[str, float, float, float]]:
@@ -103,6 +104,8 @@ class Form:
                 p += [("ln_sharpness_c2", math.log(2.0), math.log(0.5), math.log(30.0))]
             if self.c2_offset:
                 p += [("offset_c2", 0.0, -3.0, 3.0)]
+        if self.strain_growth:
+            p += [("beta_growth", 4.0, 0.0, 20.0)]
         return p
 
     @functools.cached_property
@@ -127,6 +130,7 @@ class Form:
             "source": "calibration",
             "provenance": {},
             "beta": v["beta"],
+            **({"beta_growth": v["beta_growth"]} if self.strain_growth else {}),
             "Lambda_I": lam1,
             "Lambda_III": lam1 * math.exp(v["ln_Lambda_III_over_I"]),
             "H_bar_III": {"prefactor": v["H_III"], "exp_poly": seq("H_III_n", self.n_III_H)},
@@ -209,7 +213,8 @@ def _unchecked(d: dict) -> Coefficients:
         collapse_sharpness=0.0 if col is None else col["sharpness"],
         collapse_sharpness_c2=None if col is None else col.get("sharpness_c2"),
         collapse_offset_c2=None if col is None else col.get("offset_c2"),
-        level_II_smooth=lev2["smooth"], source=d["source"], schema_version=d["schema_version"])
+        level_II_smooth=lev2["smooth"], beta_growth=d.get("beta_growth", 0.0), source=d["source"],
+        schema_version=d["schema_version"])
 
 
 def _shift_powers(d: list[float], x0: float) -> list[float]:
@@ -270,12 +275,13 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
         n_eff = ds.cache[key] = _per_point(
             ds, [0.0 if math.isinf(c.material.sigma_y) else effective_exponent(c.material, co)
                  for c in ds.curves])
-    sig, Lam, elastic = _memo(ds, "sigma_rep", (co.beta,), lambda: _sigma_rep(ds, co.beta))
+    sig, Lam, elastic = _memo(ds, "sigma_rep", (co.beta, co.beta_growth),
+                              lambda: _sigma_rep(ds, co.beta, co.beta_growth))
     y = ds.x_R if co.finite_size_ratio == "a_over_R" else ds.x_rho
     z = ds.cache.get("z")
     if z is None:  # R/ρ − 1 of the rigid partner (ρ = Hertz relative radius)
         z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
-    common = (co.beta, co.Lambda_I, co.Lambda_III, co.level_II_smooth, co.finite_size_ratio,
+    common = (co.beta, co.beta_growth, co.Lambda_I, co.Lambda_III, co.level_II_smooth, co.finite_size_ratio,
               co.eps_lo, co.eps_hi)
 
     def half_space(level_fn, fs_elastic, fs_plastic):
@@ -305,10 +311,11 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     return p, c
 
 
-def _sigma_rep(ds: Dataset, beta: float):
-    """σ_rep = σ_f(β a/ρ), Λ = E' (a/ρ)/σ_rep (0 for elastic bodies) and the elastic mask."""
+def _sigma_rep(ds: Dataset, beta: float, growth: float = 0.0):
+    """σ_rep = σ_f(ε_rep), ε_rep = β x (1 + γ x) with x = a/ρ, Λ = E' x/σ_rep (0 for elastic
+    bodies) and the elastic mask."""
     mats = [c.material for c in ds.curves]
-    eps = beta * ds.x_rho
+    eps = beta * ds.x_rho * (1.0 + growth * ds.x_rho)
     if any(m.is_tabulated for m in mats):
         sig = np.empty(ds.size)
         for i, m in enumerate(mats):
@@ -362,6 +369,14 @@ FORMS: dict[str, Form] = {
                             "sharpness and offset", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
                             n_finite_c=2, finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
                             c2_sharpness=True, c2_offset=True),
+    "smooth2_fs2_g": Form("smooth2_fs2_g", "as smooth2_fs2, representative strain growing with "
+                          "the depth of the contact, ε_rep = β x (1 + γ x)", smooth=True, n_shape_H=2,
+                          n_shape_c=2, n_finite_H=2, n_finite_c=2, finite_by_level=True,
+                          strain_growth=True),
+    "smooth2_fs2_xn_g": Form("smooth2_fs2_xn_g", "as smooth2_fs2_xn, ε_rep = β x (1 + γ x)",
+                             smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2, n_finite_c=2,
+                             finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
+                             strain_growth=True),
     # the two parts of the xnw weight alone (``--forms``)
     "smooth2_fs2_xnk": Form("smooth2_fs2_xnk", "as smooth2_fs2_xn, c² collapse weight with its own "
                             "sharpness", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
@@ -374,4 +389,4 @@ FORMS: dict[str, Form] = {
 }
 #: forms compared by cross-validation in every calibration
 CANDIDATES = ("seed", "poly", "smooth", "smooth2", "smooth2_fs", "smooth2_fs2", "smooth2_ld3",
-              "smooth2_fs2_xn", "smooth2_fs2_xnw")
+              "smooth2_fs2_xn", "smooth2_fs2_xnw", "smooth2_fs2_g", "smooth2_fs2_xn_g")

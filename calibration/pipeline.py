@@ -6,7 +6,8 @@
 
 Choice of the form, by the numbers: every candidate of ``forms.CANDIDATES`` is fitted
 and cross-validated (leave one material out); the chosen form has the smallest
-pooled CV error E_cv = sqrt((RMS_H̄² + RMS_c²²)/2) among the forms whose coefficient
+pooled CV error E_cv = sqrt((RMS_F² + RMS_a²)/2) (F and a at the FE's approaches, ``fit``)
+among the forms whose coefficient
 set passes the monotonicity/continuity check (``check``); a form with fewer parameters
 is preferred when its E_cv is within ``PARSIMONY`` (relative) of the smallest. The large-deformation
 options (ratio a/R or a/ρ, collapse blend or not) are compared on the full set with
@@ -70,9 +71,9 @@ REFERENCES = {
 
 
 def cv_score(cv: CVResult) -> float:
-    """E_cv = sqrt((RMS_H̄² + RMS_c²²)/2) of the pooled held-out errors."""
+    """E_cv = sqrt((RMS_F² + RMS_a²)/2) of the pooled held-out errors of F(h) and a(h)."""
     p = cv.pooled()
-    return math.sqrt(0.5 * (p["H_bar"]["rms"] ** 2 + p["c2"]["rms"] ** 2))
+    return math.sqrt(0.5 * (p["F"]["rms"] ** 2 + p["a"]["rms"] ** 2))
 
 
 @dataclass
@@ -161,7 +162,7 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
         if name in cv:
             return cv_score(cv[name])
         e = fits[name].errors
-        return math.sqrt(0.5 * (rms(e["H_bar"]) ** 2 + rms(e["c2"]) ** 2))
+        return math.sqrt(0.5 * (rms(e["F"]) ** 2 + rms(e["a"]) ** 2))
 
     remaining = sorted(candidates, key=lambda n: (score(n), FORMS[n].n_params, n))
     chosen = None
@@ -301,7 +302,7 @@ def calibrated_range(ds: Dataset, coeffs: Coefficients) -> dict:
     plastic = [m for m in mats if math.isfinite(m.sigma_y)]
     ns = [effective_exponent(m, coeffs) if m.is_tabulated else (m.n if m.K > 0.0 else 0.0)
           for m in plastic]
-    lam = quantities(ds, coeffs.beta)["Lambda"]
+    lam = quantities(ds, coeffs.beta, coeffs.beta_growth)["Lambda"]
     lam = lam[np.isfinite(lam) & (lam > 0.0)]
     return {
         "E_over_sigma_y": _interval([m.E / m.sigma_y for m in plastic]) if plastic else None,

@@ -44,7 +44,7 @@ def _plots(cal: Calibration, out: Path) -> list[str]:
 
     ds, best = cal.dataset, cal.best
     co = best.coeffs
-    q = quantities(ds, co.beta)
+    q = quantities(ds, co.beta, co.beta_growth)
     p_mod, c_mod = predict(ds, co)
     H_mod = p_mod / q["sigma_rep"]
     colours = _style(cal)
@@ -192,7 +192,7 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
     L.append("")
     L.append("| run | scene | points | a/R range | Λ range (fitted β) |")
     L.append("|---|---|---|---|---|")
-    q = quantities(ds, best.coeffs.beta)
+    q = quantities(ds, best.coeffs.beta, best.coeffs.beta_growth)
     for i, c in enumerate(ds.curves):
         m = ds.run == i
         L.append(f"| {c.key} | {c.scene} | {int(m.sum())} | {ds.x_R[m].min():.3f}–{ds.x_R[m].max():.3f} "
@@ -204,25 +204,29 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
              f"(warm start from the full fit, solved to a relative tolerance of {FOLD_TOL:g} with at "
              f"most {FOLD_NFEV} iterations: a fold stopped early stays near the full fit, which has "
              "seen the held-out material) and predicts the held-out points. Score "
-             "E_cv = √((RMS_H̄² + RMS_c²²)/2) over all held-out points; among the forms whose F(h) "
+             "E_cv = √((RMS_F² + RMS_a²)/2), the errors of F and a at the FE's approaches (what "
+             "validation measures; `calibration/fit.py`), over all held-out points; among the forms "
+             "whose F(h) "
              "passes the monotonicity check, the one with fewest parameters within 2 % (relative) "
              "of the smallest E_cv is chosen. 'monotone': checked for the chosen form, any form "
              "tried before it and any form with a smaller E_cv.\n")
-    L.append("| form | parameters | fit RMS H̄ | fit RMS c² | CV RMS H̄ | CV max H̄ | CV RMS c² | CV max c² "
-             "| E_cv | worst fold (c²) | monotone |")
-    L.append("|---|---|---|---|---|---|---|---|---|---|---|")
+    L.append("| form | parameters | fit RMS H̄ | fit RMS c² | fit RMS F / a | CV RMS H̄ | CV RMS c² "
+             "| CV RMS F | CV max F | CV RMS a | CV max a | E_cv | worst fold (F) | monotone |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name, f in cal.fits.items():
         s = f.summary()
         row = [f"**{name}**" if name == cal.chosen else name, str(f.form.n_params),
-               _pct(s["H_bar"]["rms"]), _pct(s["c2"]["rms"])]
+               _pct(s["H_bar"]["rms"]), _pct(s["c2"]["rms"]),
+               f"{_pct(s['F']['rms'])} / {_pct(s['a']['rms'])}"]
         if name in cal.cv:
             cv = cal.cv[name]
             p = cv.pooled()
-            g, v = cv.worst_fold("c2")
-            row += [_pct(p["H_bar"]["rms"]), _pct(p["H_bar"]["max"]), _pct(p["c2"]["rms"]),
-                    _pct(p["c2"]["max"]), _pct(cv_score(cv)), f"{g}: {_pct(v)}"]
+            g, v = cv.worst_fold("F")
+            row += [_pct(p["H_bar"]["rms"]), _pct(p["c2"]["rms"]), _pct(p["F"]["rms"]),
+                    _pct(p["F"]["max"]), _pct(p["a"]["rms"]), _pct(p["a"]["max"]),
+                    _pct(cv_score(cv)), f"{g}: {_pct(v)}"]
         else:
-            row += ["—"] * 6
+            row += ["—"] * 8
         ok = cal.form_checks.get(name)
         row.append("not checked" if ok is None else ("yes" if ok else "NO"))
         L.append("| " + " | ".join(row) + " |")

@@ -146,6 +146,10 @@ LITERATURE: dict = {
 }
 
 
+#: top-level keys a set may leave out (``to_dict`` writes them only when they are not the default)
+_OPTIONAL_TOP_KEYS = ("beta_growth",)
+
+
 def _number(d: dict, key: str, where: str) -> float:
     if key not in d:
         raise ValueError(f"coefficients: missing key '{where}{key}'")
@@ -340,6 +344,7 @@ class Coefficients:
     collapse_sharpness_c2: float | None = None  # None: the same as collapse_sharpness
     collapse_offset_c2: float | None = None     # None: 0
     level_II_smooth: bool = False
+    beta_growth: float = 0.0  # γ of ε_rep = β x (1 + γ x); 0: the linear ε_rep = β x
     source: str = "literature"
     schema_version: int = SCHEMA_VERSION
     provenance: dict = field(default_factory=dict, compare=False, hash=False, repr=False)
@@ -366,6 +371,9 @@ class Coefficients:
         beta = _number(d, "beta", "")
         if beta <= 0.0:
             raise ValueError(f"coefficients: 'beta' must be > 0, got {beta!r}")
+        growth = _number(d, "beta_growth", "") if "beta_growth" in d else 0.0
+        if not 0.0 <= growth <= 100.0:
+            raise ValueError(f"coefficients: 'beta_growth' must lie in [0, 100], got {growth!r}")
         lam1 = _number(d, "Lambda_I", "")
         lam3 = _number(d, "Lambda_III", "")
         if not 0.0 < lam1 < lam3:
@@ -463,6 +471,7 @@ class Coefficients:
             collapse_sharpness_c2=kc,
             collapse_offset_c2=sc,
             level_II_smooth=smooth,
+            beta_growth=growth,
             source=source,
             schema_version=version,
             provenance=copy.deepcopy(provenance),
@@ -476,6 +485,7 @@ class Coefficients:
             "source": self.source,
             "provenance": copy.deepcopy(self.provenance),
             "beta": self.beta,
+            **({"beta_growth": self.beta_growth} if self.beta_growth else {}),
             "Lambda_I": self.Lambda_I,
             "Lambda_III": self.Lambda_III,
             "H_bar_III": {"prefactor": self.H_bar_III_prefactor,
@@ -509,7 +519,7 @@ class Coefficients:
         """
         d = self.to_dict()
         for k, v in changes.items():
-            if k not in d:
+            if k not in d and k not in _OPTIONAL_TOP_KEYS:
                 raise ValueError(f"coefficients: unknown key {k!r}")
             d[k] = v
         return Coefficients.from_dict(d)

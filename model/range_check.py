@@ -41,7 +41,7 @@ import numpy as np
 
 from .calibrated_range import CalibratedRange, CalibrationRangeWarning
 from .coefficients import Coefficients
-from .single import effective_exponent, flow_log_slope, hardening_magnitude
+from .single import effective_exponent, flow_log_slope, hardening_magnitude, representative_strain
 from .sphere import Sphere
 
 __all__ = ["RangeCheck", "range_check", "emit"]
@@ -111,7 +111,7 @@ class RangeCheck:
 
     def __init__(self, s1: Sphere, s2: Sphere, coeffs: Coefficients, rng: CalibratedRange) -> None:
         self.range = rng
-        self.beta = coeffs.beta
+        self.coeffs = coeffs
         self.static: dict[str, str] = {}
         bodies = ((1, s1), (2, s2))
         deform = [(i, s) for i, s in bodies if not s.is_rigid]
@@ -211,7 +211,7 @@ class RangeCheck:
                 out[key] = lam[int(key[-1])]
             elif key.startswith("flow_slope_"):
                 i = int(key[-1])
-                out[key] = flow_log_slope(self._tables[i], self.beta * a / rho[i])
+                out[key] = flow_log_slope(self._tables[i], representative_strain(a / rho[i], self.coeffs)[0])
         return out
 
     def exceeded(self, values: dict[str, np.ndarray]) -> dict[str, float]:

@@ -255,7 +255,7 @@ def test_cli_writes_a_loadable_file_byte_identical_on_rerun(tmp_path, small_db, 
     assert prov["created"] == "2026-01-01"  # from the database, not the wall clock
     assert len(prov["fe_dataset"]["content_hash"]) == 64
     assert len(prov["fe_dataset"]["calibration_runs_hash"]) == 64
-    assert set(prov["fit_residuals"]) == {"H_bar", "c2"}
+    assert set(prov["fit_residuals"]) == {"H_bar", "c2", "F", "a"}
     assert set(prov["fit_residuals"]["c2"]) == {"rms", "max"}
     assert set(prov["cross_validation"]) == {"seed", "smooth"}
     assert prov["form"]["name"] == "smooth"  # the data come from the smooth form
@@ -279,3 +279,25 @@ def test_pipeline_checks_monotonicity_and_reports_model_error():
         assert e.F_max < 2e-3 and e.a_max < 2e-3, e.key
     d = coefficient_file(cal)
     assert Coefficients.from_dict(d).source == "calibration"
+
+
+def test_errors_at_the_fe_approach_match_the_model_curves_to_first_order():
+    """``fit.errors`` F and a: the error of the model's F(h), a(h) at the FE's approaches,
+    from the errors of p_m and c² at its contact radii (first order): against the curves of
+    a perturbed coefficient set evaluated at the same h."""
+    from spherecontact.calibration.fit import errors
+    from spherecontact.model import Sphere, contact
+
+    cases = SMALL[:4] + SMALL[-2:]
+    ds = build_dataset(synthetic_runs(cases))
+    other = KNOWN_CO.replace(beta=0.27, Lambda_I=2.4, Lambda_III=180.0,
+                             H_bar_III={"prefactor": 2.97, "exp_poly": [0.3]},
+                             c2_III={"prefactor": 1.39, "exp_poly": [-0.8]})
+    e = errors(ds, other)
+    for i, (case, m, Ri) in enumerate(cases):
+        sel = ds.run == i
+        st = contact(Sphere(1.0, m), Sphere(Ri, Material.rigid()), ds.h[sel], other)
+        exact_F, exact_a = st.F / ds.F[sel] - 1.0, st.a / ds.a[sel] - 1.0
+        assert np.max(np.abs(exact_F)) > 0.003, case   # the perturbation is felt
+        np.testing.assert_allclose(e["F"][sel], exact_F, atol=2e-3, err_msg=case)
+        np.testing.assert_allclose(e["a"][sel], exact_a, atol=1e-3, err_msg=case)

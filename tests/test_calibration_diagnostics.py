@@ -41,7 +41,9 @@ def test_residuals_with_memoised_parts_equal_a_fresh_evaluation(small_ds):
             p[i] += step
             co = form.coefficients(p)
             pp, cc = predict(build_dataset_like(small_ds), co)
-            want = np.concatenate([np.log(pp / small_ds.p_m), np.log(cc / small_ds.c2),
+            rc = np.log(cc / small_ds.c2)   # F and a at the FE's approach (fit.py docstring)
+            want = np.concatenate([np.log(pp / small_ds.p_m) + small_ds.slope_F * rc,
+                                   small_ds.slope_a * rc,
                                    fitmod.monotonicity_penalty(co), fitmod.collapse_penalty(co),
                                    fitmod.finite_size_penalty(co)])
             np.testing.assert_array_equal(f(p), np.where(np.isfinite(want), want, 10.0))
