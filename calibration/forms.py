@@ -377,6 +377,14 @@ FORMS: dict[str, Form] = {
                              smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2, n_finite_c=2,
                              finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
                              strain_growth=True),
+    "smooth2_fs2_xn2_g": Form("smooth2_fs2_xn2_g", "as smooth2_fs2_xn_g, x·n terms quadratic in "
+                              "a/R in both collapse limits", smooth=True, n_shape_H=2, n_shape_c=2,
+                              n_finite_H=2, n_finite_c=2, finite_by_level=True, n_collapse_xnH=2,
+                              n_collapse_xnc=2, strain_growth=True),
+    "smooth2_fs2_xn2n_g": Form("smooth2_fs2_xn2n_g", "as smooth2_fs2_xn2_g, H̄_c quadratic in the "
+                               "hardening exponent", smooth=True, n_shape_H=2, n_shape_c=2,
+                               n_finite_H=2, n_finite_c=2, finite_by_level=True, n_collapse_nH=2,
+                               n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True),
     # the two parts of the xnw weight alone (``--forms``)
     "smooth2_fs2_xnk": Form("smooth2_fs2_xnk", "as smooth2_fs2_xn, c² collapse weight with its own "
                             "sharpness", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
@@ -389,4 +397,5 @@ FORMS: dict[str, Form] = {
 }
 #: forms compared by cross-validation in every calibration
 CANDIDATES = ("seed", "poly", "smooth", "smooth2", "smooth2_fs", "smooth2_fs2", "smooth2_ld3",
-              "smooth2_fs2_xn", "smooth2_fs2_xnw", "smooth2_fs2_g", "smooth2_fs2_xn_g")
+              "smooth2_fs2_xn", "smooth2_fs2_xnw", "smooth2_fs2_g", "smooth2_fs2_xn_g",
+              "smooth2_fs2_xn2_g", "smooth2_fs2_xn2n_g")

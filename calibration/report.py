@@ -4,7 +4,8 @@ Charts: ``hbar_c2_lambda.png`` (H̄ and c² against Λ, every FE point coloured 
 material and hardening, the fitted model at the same points as lines, the half-space
 master curves a/R → 0 dashed), ``hbar_c2_aR.png`` (the same against a/R: the
 large-deformation range), ``residuals.png`` (relative residuals against Λ and a/R),
-``model_error.png`` (model F(h) and a(h) against every FE run).
+``model_error.png`` (model F(h) and a(h) against every FE run), ``cv_parameters.png``
+(held-out F and a errors against the number of parameters of every cross-validated form).
 """
 
 from __future__ import annotations
@@ -149,7 +150,37 @@ def _plots(cal: Calibration, out: Path) -> list[str]:
     fig.savefig(out / "model_error.png", dpi=110)
     plt.close(fig)
     names.append("model_error.png")
+    if cal.cv:
+        names.append(_parameters_chart(cal, out, plt))
     return names
+
+
+def _parameters_chart(cal: Calibration, out: Path, plt) -> str:
+    """Held-out error of F(h) and a(h) (RMS and max over the folds) against the number of
+    parameters of every cross-validated form: ``cv_parameters.png``."""
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    for name, cv in cal.cv.items():
+        n = cal.fits[name].form.n_params
+        pooled = cv.pooled()
+        bold = name == cal.chosen
+        for ax, key in zip(axes, ("rms", "max"), strict=True):
+            for q, mk, col in (("F", "o", "tab:blue"), ("a", "s", "tab:orange")):
+                ax.plot(n, 100 * pooled[q][key], mk, color=col, ms=9 if bold else 5,
+                        mec="k" if bold else col)
+            ax.annotate(name, (n, 100 * pooled["F"][key]), fontsize=7, xytext=(3, 3),
+                        textcoords="offset points")
+    for ax, t in zip(axes, ("held-out RMS error [%]", "held-out max |error| [%]"), strict=True):
+        ax.set_xlabel("parameters of the form")
+        ax.set_ylabel(t)
+        ax.grid(alpha=0.3)
+    axes[0].plot([], [], "o", color="tab:blue", label="F(h)")
+    axes[0].plot([], [], "s", color="tab:orange", label="a(h)")
+    axes[0].legend()
+    fig.suptitle("leave-one-material-out cross-validation: error against parameters (chosen form: large)")
+    fig.tight_layout()
+    fig.savefig(out / "cv_parameters.png", dpi=110)
+    plt.close(fig)
+    return "cv_parameters.png"
 
 
 def _pct(x: float) -> str:

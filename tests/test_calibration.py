@@ -264,7 +264,8 @@ def test_cli_writes_a_loadable_file_byte_identical_on_rerun(tmp_path, small_db, 
     co = load_coefficients()
     assert co.source == "calibration" and co.has_collapse
     rep = (tmp_path / "rep" / "index.md").read_text()
-    for png in ("hbar_c2_lambda.png", "hbar_c2_aR.png", "residuals.png", "model_error.png"):
+    for png in ("hbar_c2_lambda.png", "hbar_c2_aR.png", "residuals.png", "model_error.png",
+                "cv_parameters.png"):
         assert (tmp_path / "rep" / png).stat().st_size > 10_000
         assert png in rep
     assert "cross-validation" in rep and "| **smooth** |" in rep
