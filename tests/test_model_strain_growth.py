@@ -69,3 +69,17 @@ def test_bad_growth_is_named(bad):
     d["beta_growth"] = bad
     with pytest.raises(ValueError, match="beta_growth"):
         Coefficients.from_dict(d)
+
+
+def test_level_I_follows_the_fe_elastic_sphere_within_half_a_percent():
+    """Issue target: the shipped model's elastic sphere on a flat against the FE's elastic
+    hemisphere (``make verify-fem``, F/Hertz at h/R = 0.002, 0.005, 0.01)."""
+    from pathlib import Path
+
+    fe = json.loads((Path(__file__).resolve().parents[1] / "reports" / "fem" /
+                     "fem_verification.json").read_text())["hertz"]["F_over_Hertz_at_h"]
+    m = Material(E=1000.0, nu=0.3)   # elastic: σ_Y = inf
+    h = np.array([float(k) for k in fe])
+    F = contact(Sphere(1.0, m), FLAT, h).F
+    hertz = 4.0 / 3.0 * m.E_prime * h**1.5
+    np.testing.assert_allclose(F / hertz, [fe[k] for k in fe], rtol=0.005)
