@@ -16,6 +16,7 @@ dropping a material. The folds of all forms are independent tasks (``workers``).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,7 +27,8 @@ from .fit import FitResult, errors, fit, rms
 from .forms import Form, predict
 from .workers import Workers
 
-__all__ = ["FOLD_NFEV", "Fold", "CVResult", "fold_fit", "cross_validate", "cross_validate_many"]
+__all__ = ["FOLD_NFEV", "Fold", "CVResult", "fold_fit", "cross_validate", "cross_validate_many",
+           "REGIMES", "regime_of", "RegimeFold", "regime_fold_fit", "cross_validate_regimes"]
 
 #: iteration cap of a fold fit (warm-started from the full fit)
 FOLD_NFEV = 30
@@ -96,3 +98,66 @@ def cross_validate_many(ds: Dataset, fulls: list[FitResult], nfev: int = FOLD_NF
     folds = workers.map(fold_fit, tasks) if workers is not None else [fold_fit(ds, *t) for t in tasks]
     n = len(groups)
     return [CVResult(form=f.form.name, folds=folds[i * n:(i + 1) * n]) for i, f in enumerate(fulls)]
+
+
+# ------------------------------------------------------------------ held-out regimes
+#: regime families and how a run is labelled in each: an E/σY decade, a hardening magnitude
+#: band, a partner (flat or rigid-sphere radius band). A fold holds out every run of one label.
+REGIMES = ("E/σY decade", "K/σY", "partner")
+
+
+def regime_of(curve, family: str) -> str:
+    """Label of a calibration run (``dataset.RunCurve``) in a regime family of ``REGIMES``."""
+    m = curve.material
+    if family == "E/σY decade":
+        if math.isinf(m.sigma_y):
+            return "elastic"
+        k = math.floor(math.log10(m.E / m.sigma_y) + 1e-9)
+        return f"1e{k}–1e{k + 1}"
+    if family == "K/σY":
+        if m.is_tabulated:
+            return "tabulated curve"
+        K = 0.0 if math.isinf(m.sigma_y) else m.K / m.sigma_y
+        if K == 0.0:
+            return "0"
+        return "0–2" if K <= 2.0 else ("2–5" if K <= 5.0 else "> 5")
+    if family == "partner":
+        if math.isinf(curve.indenter_radius):
+            return "flat"
+        r = curve.indenter_radius / curve.radius
+        return "R_i/R < 0.5" if r < 0.5 else ("R_i/R 0.5–1.5" if r <= 1.5 else "R_i/R > 1.5")
+    raise ValueError(f"regime family must be one of {REGIMES}, got {family!r}")
+
+
+@dataclass
+class RegimeFold:
+    family: str
+    label: str
+    runs: int
+    errors: dict[str, np.ndarray]   # held-out relative errors (``fit.errors``)
+
+
+def regime_fold_fit(ds: Dataset, form: Form, params: np.ndarray, family: str, label: str,
+                    nfev: int = FOLD_NFEV) -> RegimeFold:
+    """Refit ``form`` without the runs of ``label`` in ``family`` (warm start ``params``) and
+    predict them."""
+    held = [i for i, c in enumerate(ds.curves) if regime_of(c, family) == label]
+    keep = [i for i in range(len(ds.curves)) if i not in set(held)]
+    r = fit(ds.subset(keep), form, start=params, max_nfev=nfev, tol=FOLD_TOL)
+    return RegimeFold(family, label, len(held), errors(ds.subset(held), r.coeffs))
+
+
+def cross_validate_regimes(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV,
+                           workers: Workers | None = None) -> list[RegimeFold]:
+    """Hold out one regime at a time (every label of every family of ``REGIMES`` that leaves
+    runs to fit), refit ``full.form`` and predict the held-out runs: how the form extrapolates
+    to a decade of E/σY, a hardening band or a partner it was not fitted on."""
+    tasks = []
+    for family in REGIMES:
+        labels = sorted({regime_of(c, family) for c in ds.curves})
+        if len(labels) < 2:
+            continue
+        tasks += [(full.form, full.params, family, lab, nfev) for lab in labels]
+    if workers is not None:
+        return workers.map(regime_fold_fit, tasks)
+    return [regime_fold_fit(ds, *t) for t in tasks]

@@ -30,7 +30,7 @@ import numpy as np
 from ..model.coefficients import Coefficients
 from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
-from .crossval import CVResult, cross_validate_many
+from .crossval import CVResult, RegimeFold, cross_validate_many, cross_validate_regimes
 from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import FitResult, fit, rms, round_sig
@@ -93,6 +93,7 @@ class Calibration:
     timings: dict = field(default_factory=dict)
     noise: dict = field(default_factory=dict)      # scatter of the FE points (diagnostics.noise_floor)
     breakdown: dict = field(default_factory=dict)  # residuals of the chosen form by band
+    regimes: list[RegimeFold] = field(default_factory=list)  # chosen form, one regime held out
 
     @property
     def best(self) -> FitResult:
@@ -195,6 +196,11 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
         for label, (r, ok) in zip(variants, done, strict=True):
             alternatives[label], alt_ok[label] = r, ok
         timings["alternatives_s"] = time.perf_counter() - t
+    regimes = []
+    if cross_validation and len(ds.curves) >= 2:
+        t = time.perf_counter()
+        regimes = cross_validate_regimes(ds, fits[chosen], workers=pool)
+        timings["regimes_s"] = time.perf_counter() - t
     errs = [run_errors(c, fits[chosen].coeffs) for c in ds.curves]
     t = time.perf_counter()
     noise = noise_floor(ds)
@@ -202,7 +208,8 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
     timings["diagnostics_s"] = time.perf_counter() - t
     return Calibration(dataset=ds, fits=fits, cv=cv, chosen=chosen, checks=checks[chosen],
                        run_errors=errs, alternatives=alternatives, alternative_checks=alt_ok,
-                       form_checks=dict(checks_ok), timings=timings, noise=noise, breakdown=bands)
+                       form_checks=dict(checks_ok), timings=timings, noise=noise, breakdown=bands,
+                       regimes=regimes)
 
 
 def load_runs(db_path, include_stopped: bool = True):
@@ -352,6 +359,10 @@ def coefficient_file(cal: Calibration) -> dict:
         "cross_validation": {n: {q: {k: _stat(v) for k, v in s.items()}
                                  for q, s in cv.pooled().items()} | {"score": _stat(cv_score(cv))}
                              for n, cv in cal.cv.items()},
+        "cross_validation_regimes": {
+            f"{r.family}: {r.label}": {"runs": r.runs} | {
+                q: {"rms": _stat(rms(r.errors[q])), "max": _stat(float(np.max(np.abs(r.errors[q]))))}
+                for q in ("F", "a")} for r in cal.regimes},
         "model_error_per_run": {e.key: {"F": {"rms": _stat(e.F_rms), "max": _stat(e.F_max)},
                                         "a": {"rms": _stat(e.a_rms), "max": _stat(e.a_max)}}
                                 for e in cal.run_errors},

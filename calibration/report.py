@@ -262,6 +262,18 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
         row.append("not checked" if ok is None else ("yes" if ok else "NO"))
         L.append("| " + " | ".join(row) + " |")
     L.append("")
+    if cal.regimes:
+        L.append(f"Held out by regime (chosen form `{cal.chosen}`, refitted without every run of "
+                 "one regime and predicting them: extrapolation to a decade of E/σY, a hardening "
+                 "band or a partner it was not fitted on; errors of F and a at the FE's approaches):\n")
+        L.append("| regime held out | runs | RMS F | max F | RMS a | max a |")
+        L.append("|---|---|---|---|---|---|")
+        for r in cal.regimes:
+            eF, ea = r.errors["F"], r.errors["a"]
+            L.append(f"| {r.family}: {r.label} | {r.runs} | {_pct(rms(eF))} | "
+                     f"{_pct(float(np.max(np.abs(eF))))} | {_pct(rms(ea))} | "
+                     f"{_pct(float(np.max(np.abs(ea))))} |")
+        L.append("")
     for name, f in cal.fits.items():
         L.append(f"* `{name}`: {f.form.description}"
                  + (f"; parameters at a bound: {', '.join(f.at_bounds)}" if f.at_bounds else ""))

@@ -22,6 +22,7 @@ them and ``--prune`` removes them, so a set never holds two runs of one case.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import datetime as _dt
 import json
 import math
@@ -375,9 +376,12 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
                 record = Record(key=case.key, set=case.set, case=case.name, status=out.status,
                                 reason=out.reason, wall_s=out.wall_s, inputs=case.inputs,
                                 params=case.params)
-                append_run(db_path, record, out.result, out.provenance, traceback=out.traceback,
-                           campaign_text=campaign.text, campaign_source=campaign.source,
-                           replace=present == "stopped")
+                try:
+                    append_run(db_path, record, out.result, out.provenance, traceback=out.traceback,
+                               campaign_text=campaign.text, campaign_source=campaign.source,
+                               replace=present == "stopped")
+                except ValueError as err:  # a result the writer rejects fails its case, not the campaign
+                    out = _unwritable(db_path, record, present, err, campaign)
                 bar.update(1)
                 _log(bar, f"[{done}/{len(todo)}] {case.set} {case.name}: {out.status} "
                           f"({out.wall_s:.1f} s){'' if out.status == 'converged' else ': ' + out.reason}")
@@ -388,6 +392,18 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
     if db_path.exists():
         _write_json(Path(f"{db_path}.summary.json"), summary)
     return summary
+
+
+def _unwritable(db_path, record: Record, present: str, err: ValueError, campaign: Campaign) -> Outcome:
+    """A finished run whose result cannot be written (``err``): recorded as failed with the
+    reason, unless the database already holds a stopped run of the case, which is kept."""
+    reason = f"result could not be stored: {err}"
+    if present != "stopped":
+        failed = dataclasses.replace(record, status="failed", reason=reason)
+        append_run(db_path, failed, None, None, traceback="".join(_traceback.format_exception(err)),
+                   campaign_text=campaign.text, campaign_source=campaign.source)
+    return Outcome(record.key, "failed", reason + ("" if present != "stopped" else
+                                                   " (the stored stopped run is kept)"), record.wall_s)
 
 
 def dry_run(campaign: Campaign, db_path, sets=None, only: str | None = None) -> str:

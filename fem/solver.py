@@ -462,9 +462,17 @@ class CycleLegs:
             return False
         return True
 
+    def _per_increment_lists(self) -> dict[str, list]:
+        """Every list that grows by one entry per increment: the curves in ``self._hist`` and a
+        solver's own per-increment records (``self._profiles`` of the two-body solver)."""
+        lists = {k: v for k, v in vars(self._hist).items() if isinstance(v, list)}
+        for i, v in enumerate(getattr(self, "_profiles", ())):
+            lists[f"_profiles[{i}]"] = v
+        return lists
+
     def _snapshot(self, run: _RunState, dh: float) -> tuple:
         """The run before an increment of ``dh`` is committed (for :meth:`_back_up`)."""
-        return copy.copy(run), {k: len(v) for k, v in vars(self._hist).items() if isinstance(v, list)}, dh
+        return copy.copy(run), {k: len(v) for k, v in self._per_increment_lists().items()}, dh
 
     def _back_up(self, run: _RunState, before: tuple | None) -> bool:
         """Undo the last loading increment when every step from it has failed down to dh_min,
@@ -480,9 +488,9 @@ class CycleLegs:
             return False
         saved, lengths, dh = before
         vars(run).update(vars(saved))
-        hist = vars(self._hist)
+        lists = self._per_increment_lists()
         for key, n in lengths.items():
-            del hist[key][n:]
+            del lists[key][n:]
         run.dh = BACK_UP_STEP * dh
         self.backed_up_increments += 1
         return True

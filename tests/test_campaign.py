@@ -350,3 +350,24 @@ def test_campaign_on_a_dask_cluster(tmp_path):
     _, run = db.runs(set="validation")[0]
     assert run.inputs["indenter_radius"] == 2.0
     assert run.provenance["extra"]["entry_point"] == "spherecontact.fem.campaign"
+
+
+def test_a_result_the_writer_rejects_fails_its_case_not_the_campaign(tmp_path):
+    """Campaign v2: a two-body result with more profile rows than increments raised in the
+    writer and ended the whole campaign; now that case is recorded as failed (or, when a
+    stopped run of it is stored, that run is kept) and the other cases are stored."""
+    c = parse_campaign(tiny('[[calibration]]\nscene = "flat"\nE_over_sigma_y = [100, 200]\n'))
+    db_path = tmp_path / "ref.h5"
+
+    def runner(case):
+        out = fc.execute(case)
+        if case.name.startswith("flat-pp-E200"):
+            r = out.result
+            r.profile_r = r.profile_r[:-1]   # one row short: the writer rejects it
+        return out
+
+    summary = fc.run_campaign(c, db_path, workers=0, runner=runner)
+    assert summary["total"] == {**summary["total"], "cases": 2, "converged": 1, "failed": 1}
+    (fail,) = Database(db_path).failed()
+    assert fail.case == "flat-pp-E200-nu0.3" and fail.reason.startswith("result could not be stored")
+    assert "profile_r" in fail.reason

@@ -196,3 +196,29 @@ def test_a_dead_end_increment_is_undone_and_the_run_goes_on(monkeypatch):
     monkeypatch.setattr(solver_module, "MAX_BACK_UPS", 0)
     stuck = IndentationSolver(mat, 1.0, RigidObstacle()).run(1e-3)
     assert stuck.status == "stopped" and "dh_min" in stuck.reason and stuck.h.size == 5
+
+
+def test_an_undone_increment_of_two_bodies_leaves_no_profile_row(monkeypatch):
+    """The two-body solver keeps its residual histories and surface profiles apart from the
+    curves; an undone increment must take its rows with it (campaign v2, E ratio 3 pair: ten
+    back-ups left 316 profile rows for 306 increments and the run could not be written)."""
+    from spherecontact.fem.io import run_indentation
+    from spherecontact.fem.solver import IncrementFailed
+    from spherecontact.fem.twobody import TwoBodySolver
+
+    solve = TwoBodySolver._solve
+
+    def trapped(self, run, h_new):
+        if len(self._hist.h) == 4 and self.backed_up_increments == 0:
+            err = IncrementFailed("trapped (test)")
+            self.rejected.append((h_new, h_new - run.h, str(err)))
+            return err
+        return solve(self, run, h_new)
+
+    monkeypatch.setattr(TwoBodySolver, "_solve", trapped)
+    m1 = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    m2 = Material(E=200.0, nu=0.3, sigma_y=2.0)
+    res = run_indentation(m1, 1.0, 0.002, radius2=2.0, material2=m2, density=0.5)
+    assert res.timings["backed_up_increments"] == 1 and res.status == "converged"
+    assert np.all(np.diff(res.h) > 0)
+    assert len(res.residuals) == res.h.size == res.profile_r.shape[0] == res.profile_p.shape[0]
