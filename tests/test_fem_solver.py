@@ -169,6 +169,23 @@ def test_points_toggling_at_yield_in_a_two_cycle_are_kept_elastic():
     assert abs(kept.P[3, 0]) > abs(free.P[3, 0])  # the frozen point's stress stays above yield
 
 
+def _trap_until_a_back_up(monkeypatch, solver_class, after: int) -> None:
+    """Every step from increment ``after`` of ``solver_class`` fails until one increment has
+    been undone (a dead end, as in campaign v2)."""
+    from spherecontact.fem.solver import IncrementFailed
+
+    solve = solver_class._solve
+
+    def trapped(self, run, h_new):
+        if len(self._hist.h) == after and self.backed_up_increments == 0:
+            err = IncrementFailed("trapped (test)")
+            self.rejected.append((h_new, h_new - run.h, str(err)))
+            return err
+        return solve(self, run, h_new)
+
+    monkeypatch.setattr(solver_class, "_solve", trapped)
+
+
 def test_a_dead_end_increment_is_undone_and_the_run_goes_on(monkeypatch):
     """A converged increment can end in a state no step leaves (campaign v2, rigid sphere
     R2/R1 = 2.07, Ludwik K/σY = 6.2, n = 0.149 on the band mesh: the increment to h/R = 6.3e-4
@@ -176,18 +193,8 @@ def test_a_dead_end_increment_is_undone_and_the_run_goes_on(monkeypatch):
     Here every step from the fifth increment fails until one increment has been undone: the
     run undoes it and steps on from the one before; without back-ups it stops."""
     import spherecontact.fem.solver as solver_module
-    from spherecontact.fem.solver import IncrementFailed
 
-    solve = IndentationSolver._solve
-
-    def trapped(self, run, h_new):
-        if len(self._hist.h) == 5 and self.backed_up_increments == 0:
-            err = IncrementFailed("trapped (test)")
-            self.rejected.append((h_new, h_new - run.h, str(err)))
-            return err
-        return solve(self, run, h_new)
-
-    monkeypatch.setattr(IndentationSolver, "_solve", trapped)
+    _trap_until_a_back_up(monkeypatch, IndentationSolver, after=5)
     mat = Material(E=200.0, nu=0.3, sigma_y=1.0)
     res = IndentationSolver(mat, 1.0, RigidObstacle()).run(1e-3)
     assert res.status == "converged" and res.timings["backed_up_increments"] == 1
@@ -203,19 +210,9 @@ def test_an_undone_increment_of_two_bodies_leaves_no_profile_row(monkeypatch):
     curves; an undone increment must take its rows with it (campaign v2, E ratio 3 pair: ten
     back-ups left 316 profile rows for 306 increments and the run could not be written)."""
     from spherecontact.fem.io import run_indentation
-    from spherecontact.fem.solver import IncrementFailed
     from spherecontact.fem.twobody import TwoBodySolver
 
-    solve = TwoBodySolver._solve
-
-    def trapped(self, run, h_new):
-        if len(self._hist.h) == 4 and self.backed_up_increments == 0:
-            err = IncrementFailed("trapped (test)")
-            self.rejected.append((h_new, h_new - run.h, str(err)))
-            return err
-        return solve(self, run, h_new)
-
-    monkeypatch.setattr(TwoBodySolver, "_solve", trapped)
+    _trap_until_a_back_up(monkeypatch, TwoBodySolver, after=4)
     m1 = Material(E=200.0, nu=0.3, sigma_y=1.0)
     m2 = Material(E=200.0, nu=0.3, sigma_y=2.0)
     res = run_indentation(m1, 1.0, 0.002, radius2=2.0, material2=m2, density=0.5)
