@@ -68,6 +68,11 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
         f"* Thresholds: `{th_path}` — max |F error| ≤ {pct(th.F_max, 0)} %, max |a error| ≤ "
         f"{pct(th.a_max, 0)} % per run, from the end of Level I to h/R = {th.h_over_R_max:g}.",
     ]
+    transient = [c for c in validation if not np.array_equal(c.reference, c.loading)]
+    if transient:
+        lines.append(f"* FE increments: {len(transient)} of the runs began with a first step above the "
+                     "strain bound Δε²·R; their increments below 2.5× that step (its transient, "
+                     "`fem.io.reference_mask`, data/README.md) are left out of every comparison.")
     if skipped:
         lines.append(f"* Not compared (no converged curve): {', '.join(skipped)}.")
     return lines
