@@ -376,6 +376,12 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
                 record = Record(key=case.key, set=case.set, case=case.name, status=out.status,
                                 reason=out.reason, wall_s=out.wall_s, inputs=case.inputs,
                                 params=case.params)
+                if present == "stopped" and _not_further(db_path, case.key, out):
+                    bar.update(1)
+                    _log(bar, f"[{done}/{len(todo)}] {case.set} {case.name}: stopped again, at "
+                              f"h = {_reached(out):.6g}, short of the stored run: the stored run is "
+                              f"kept ({out.reason})")
+                    continue
                 try:
                     append_run(db_path, record, out.result, out.provenance, traceback=out.traceback,
                                campaign_text=campaign.text, campaign_source=campaign.source,
@@ -392,6 +398,22 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
     if db_path.exists():
         _write_json(Path(f"{db_path}.summary.json"), summary)
     return summary
+
+
+def _reached(out: Outcome) -> float:
+    """The largest approach of a run's loading curve (0 without a result)."""
+    if out.result is None or len(out.result.curves.get("h", ())) == 0:
+        return 0.0
+    return float(max(out.result.curves["h"]))
+
+
+def _not_further(db_path, key: str, out: Outcome) -> bool:
+    """True when a retried run that did not converge got no further than the stopped run stored
+    under ``key``: the stored run, which holds more of the curve, is kept."""
+    if out.status == "converged":
+        return False
+    stored = Database(db_path).run(key)
+    return _reached(out) <= float(max(stored.h))
 
 
 def _unwritable(db_path, record: Record, present: str, err: ValueError, campaign: Campaign) -> Outcome:

@@ -10,6 +10,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from spherecontact.data import Database, input_key
@@ -371,3 +372,31 @@ def test_a_result_the_writer_rejects_fails_its_case_not_the_campaign(tmp_path):
     (fail,) = Database(db_path).failed()
     assert fail.case == "flat-pp-E200-nu0.3" and fail.reason.startswith("result could not be stored")
     assert "profile_r" in fail.reason
+
+
+def test_a_retry_that_gets_no_further_keeps_the_stored_stopped_run(tmp_path):
+    """Campaign v2: a retried two-body pair stopped at h/R = 0.046 and replaced the stored run
+    that had reached 0.073. A retry that does not converge replaces the stored run only when it
+    gets further; one that fails keeps it too."""
+    body = '[[calibration]]\nscene = "flat"\nE_over_sigma_y = 100\nmax_wall_s = {}\n'
+    db_path = tmp_path / "ref.h5"
+    fc.run_campaign(parse_campaign(tiny(body.format(0.001), h_max=0.02)), db_path, workers=0)
+    (rec,) = Database(db_path).records(status="stopped")
+    h_stored = Database(db_path).run(rec.key).h.copy()
+
+    def short(case):   # stops at once: no further than the stored run
+        r = fc.execute(case).result
+        r.curves = {k: v[:1] for k, v in r.curves.items()}
+        r.residuals = r.residuals[:1]
+        r.profile_r, r.profile_p, r.profile_g = r.profile_r[:1], r.profile_p[:1], r.profile_g[:1]
+        return fc.Outcome(case.key, "stopped", "increment below dh_min (test)", 0.1, r)
+
+    def failing(case):
+        return fc.Outcome(case.key, "failed", "RuntimeError: boom", 0.0, traceback="Traceback ...")
+
+    again = parse_campaign(tiny(body.format(600), h_max=0.02))
+    for runner in (short, failing):
+        summary = fc.run_campaign(again, db_path, workers=0, retry_stopped=True, runner=runner)
+        assert summary["ran"] == 1 and summary["total"]["stopped"] == 1
+        db = Database(db_path)
+        assert db.failed() == [] and np.array_equal(db.run(rec.key).h, h_stored)
