@@ -142,7 +142,7 @@ def regime_fold_fit(ds: Dataset, form: Form, params: np.ndarray, family: str, la
     """Refit ``form`` without the runs of ``label`` in ``family`` (warm start ``params``) and
     predict them."""
     held = [i for i, c in enumerate(ds.curves) if regime_of(c, family) == label]
-    keep = [i for i in range(len(ds.curves)) if i not in set(held)]
+    keep = [i for i, c in enumerate(ds.curves) if regime_of(c, family) != label]
     r = fit(ds.subset(keep), form, start=params, max_nfev=nfev, tol=FOLD_TOL)
     return RegimeFold(family, label, len(held), errors(ds.subset(held), r.coeffs))
 

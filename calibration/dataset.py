@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.material import Material
+from ..model.single import representative_strain
 
 __all__ = [
     "A_MIN_ELEMENTS",
@@ -260,7 +261,7 @@ def quantities(ds: Dataset, beta: float, growth: float = 0.0) -> dict[str, np.nd
     dict with ``sigma_rep``, ``Lambda``, ``H_bar`` (NaN-free; elastic runs have
     σ_rep = inf, Λ = 0 and H̄ = 0) and ``eps_rep``.
     """
-    eps = beta * ds.x_rho * (1.0 + growth * ds.x_rho)
+    eps = representative_strain(ds.x_rho, beta, growth)[0]
     sig = np.empty_like(eps)
     for i, c in enumerate(ds.curves):
         m = ds.run == i

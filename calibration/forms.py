@@ -27,7 +27,7 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients, CollapseLimit
-from ..model.single import BodyLaw, curvature_ratio, effective_exponent
+from ..model.single import BodyLaw, curvature_ratio, effective_exponent, representative_strain
 from .dataset import Dataset
 
 #: collapse c²_c is parametrised by its value and slopes at this a/R
@@ -315,7 +315,7 @@ def _sigma_rep(ds: Dataset, beta: float, growth: float = 0.0):
     """σ_rep = σ_f(ε_rep), ε_rep = β x (1 + γ x) with x = a/ρ, Λ = E' x/σ_rep (0 for elastic
     bodies) and the elastic mask."""
     mats = [c.material for c in ds.curves]
-    eps = beta * ds.x_rho * (1.0 + growth * ds.x_rho)
+    eps = representative_strain(ds.x_rho, beta, growth)[0]
     if any(m.is_tabulated for m in mats):
         sig = np.empty(ds.size)
         for i, m in enumerate(mats):

@@ -376,7 +376,7 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
                 record = Record(key=case.key, set=case.set, case=case.name, status=out.status,
                                 reason=out.reason, wall_s=out.wall_s, inputs=case.inputs,
                                 params=case.params)
-                if present == "stopped" and _not_further(db_path, case.key, out):
+                if present == "stopped" and _not_further(db, case.key, out):
                     bar.update(1)
                     _log(bar, f"[{done}/{len(todo)}] {case.set} {case.name}: stopped again, at "
                               f"h = {_reached(out):.6g}, short of the stored run: the stored run is "
@@ -407,13 +407,13 @@ def _reached(out: Outcome) -> float:
     return float(max(out.result.curves["h"]))
 
 
-def _not_further(db_path, key: str, out: Outcome) -> bool:
+def _not_further(db: Database, key: str, out: Outcome) -> bool:
     """True when a retried run that did not converge got no further than the stopped run stored
-    under ``key``: the stored run, which holds more of the curve, is kept."""
+    under ``key`` in ``db`` (opened when the campaign started): the stored run, which holds
+    more of the curve, is kept."""
     if out.status == "converged":
         return False
-    stored = Database(db_path).run(key)
-    return _reached(out) <= float(max(stored.h))
+    return _reached(out) <= float(max(db.run(key).h))
 
 
 def _unwritable(db_path, record: Record, present: str, err: ValueError, campaign: Campaign) -> Outcome:

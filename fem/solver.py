@@ -463,12 +463,9 @@ class CycleLegs:
         return True
 
     def _per_increment_lists(self) -> dict[str, list]:
-        """Every list that grows by one entry per increment: the curves in ``self._hist`` and a
-        solver's own per-increment records (``self._profiles`` of the two-body solver)."""
-        lists = {k: v for k, v in vars(self._hist).items() if isinstance(v, list)}
-        for i, v in enumerate(getattr(self, "_profiles", ())):
-            lists[f"_profiles[{i}]"] = v
-        return lists
+        """Every list that grows by one entry per increment (the curves in ``self._hist``); a
+        solver that keeps more per-increment records adds them."""
+        return {k: v for k, v in vars(self._hist).items() if isinstance(v, list)}
 
     def _snapshot(self, run: _RunState, dh: float) -> tuple:
         """The run before an increment of ``dh`` is committed (for :meth:`_back_up`)."""

@@ -550,6 +550,13 @@ class TwoBodySolver(CycleLegs):
         """Deformed (r, z) of the slave's contact candidates."""
         return self.slave.positions(u, self.candidates)
 
+    def _per_increment_lists(self) -> dict[str, list]:
+        """The curves and this solver's residual histories and surface profiles (one entry per
+        increment each), so that an undone increment takes all its rows with it."""
+        lists = super()._per_increment_lists()
+        lists.update({f"_profiles[{i}]": v for i, v in enumerate(self._profiles)})
+        return lists
+
     def _solve(self, run: _RunState, h_new: float):
         """Newton for one increment to ``h_new``: the converged tuple, or the exception."""
         dh = h_new - run.h

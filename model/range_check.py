@@ -211,7 +211,8 @@ class RangeCheck:
                 out[key] = lam[int(key[-1])]
             elif key.startswith("flow_slope_"):
                 i = int(key[-1])
-                out[key] = flow_log_slope(self._tables[i], representative_strain(a / rho[i], self.coeffs)[0])
+                eps = representative_strain(a / rho[i], self.coeffs.beta, self.coeffs.beta_growth)[0]
+                out[key] = flow_log_slope(self._tables[i], eps)
         return out
 
     def exceeded(self, values: dict[str, np.ndarray]) -> dict[str, float]:

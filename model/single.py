@@ -79,12 +79,13 @@ def flow_log_slope(material: Material, eps) -> np.ndarray:
     return material.n * t / (material.sigma_y + t)
 
 
-def representative_strain(x, coeffs: Coefficients):
+def representative_strain(x, beta: float, growth: float = 0.0):
     """ε_rep = β x (1 + γ x) and its log slope g = d ln ε_rep/d ln x = (1 + 2γx)/(1 + γx)
-    (vectorised; x = a/ρ, β = ``coeffs.beta``, γ = ``coeffs.beta_growth``)."""
+    (vectorised; x = a/ρ, β = ``beta``, γ = ``growth``: a coefficient set's ``beta`` and
+    ``beta_growth``)."""
     x = np.asarray(x, dtype=float)
-    gx = coeffs.beta_growth * x
-    return coeffs.beta * x * (1.0 + gx), (1.0 + 2.0 * gx) / (1.0 + gx)
+    gx = growth * x
+    return beta * x * (1.0 + gx), (1.0 + 2.0 * gx) / (1.0 + gx)
 
 
 def curvature_ratio(radius, rho_hertz):
@@ -188,7 +189,7 @@ class BodyLaw:
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
         Ep = mat.E_prime
-        eps, g = representative_strain(x, co)
+        eps, g = representative_strain(x, co.beta, co.beta_growth)
         if math.isinf(mat.sigma_y):  # elastic: always Level I
             sig = np.full_like(x, math.inf)
             Lam = np.zeros_like(x)

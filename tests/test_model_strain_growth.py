@@ -27,13 +27,13 @@ def _with_growth(co: Coefficients, g: float) -> Coefficients:
 def test_strain_and_its_log_slope():
     co = _with_growth(CO, 5.0)
     x = np.array([1e-3, 0.1, 0.5, 1.0])
-    eps, g = representative_strain(x, co)
+    eps, g = representative_strain(x, co.beta, co.beta_growth)
     np.testing.assert_allclose(eps, co.beta * x * (1 + 5.0 * x))
     e = 1e-7
-    fd = np.log(representative_strain(x * (1 + e), co)[0] / eps) / e
+    fd = np.log(representative_strain(x * (1 + e), co.beta, co.beta_growth)[0] / eps) / e
     np.testing.assert_allclose(g, fd, rtol=1e-5)
     # γ = 0 is the seed's ε_rep = β x, with slope 1
-    eps0, g0 = representative_strain(x, _with_growth(CO, 0.0))
+    eps0, g0 = representative_strain(x, CO.beta)
     np.testing.assert_allclose(eps0, CO.beta * x)
     np.testing.assert_array_equal(g0, 1.0)
 

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fem.io import START_TRANSIENT
 from ..model import Coefficients, default_coefficients
 from .cases import Case
 from .charts import curves_chart, error_chart, representative
@@ -71,8 +72,9 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
     transient = [c for c in validation if not np.array_equal(c.reference, c.loading)]
     if transient:
         lines.append(f"* FE increments: {len(transient)} of the runs began with a first step above the "
-                     "strain bound Δε²·R; their increments below 2.5× that step (its transient, "
-                     "`fem.io.reference_mask`, data/README.md) are left out of every comparison.")
+                     f"strain bound Δε²·R; their increments below {START_TRANSIENT:g}× that step (its "
+                     "transient, `fem.io.reference_mask`, data/README.md) are left out of every "
+                     "comparison.")
     if skipped:
         lines.append(f"* Not compared (no converged curve): {', '.join(skipped)}.")
     return lines
