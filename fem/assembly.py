@@ -88,6 +88,11 @@ class Discretisation:
         return self.node_block_slots(I, J)
 
     @property
+    def csr_pattern(self) -> tuple[np.ndarray, np.ndarray]:
+        """(indptr, indices) of the fixed CSR pattern (sorted, whole diagonal stored)."""
+        return self._indptr, self._indices
+
+    @property
     def n_entries(self) -> int:
         """Number of stored entries of the fixed sparsity pattern."""
         return self._nnz

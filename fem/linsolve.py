@@ -2,7 +2,7 @@
 
 The tangent of the total-Lagrangian problem is symmetric (exact tangent of a
 potential; the contact constraints are eliminated symmetrically, see
-:func:`constrain`). ``qdldl`` (Stellato, Banjac et al., the LDLᵀ of OSQP:
+:class:`ConstrainedPattern`). ``qdldl`` (Stellato, Banjac et al., the LDLᵀ of OSQP:
 approximate minimum degree ordering, then an up-looking LDLᵀ without pivoting)
 factors it about 3× faster than SuperLU, and ``Solver.update`` refactors a
 matrix of the same sparsity pattern without redoing the ordering and the
@@ -107,6 +107,41 @@ class SymmetricSolver:
         """Upper-triangular CSC matrix of the stored pattern holding ``data``."""
         return sp.csc_matrix((data, self._rows, self._indptr), shape=(self._n, self._n))
 
+    def solve_upper(self, U: sp.csc_matrix, diag: np.ndarray, b: np.ndarray, key: object) -> np.ndarray:
+        """x with K x = b, K given by its upper triangle ``U`` (sorted CSC) and its diagonal
+        ``diag``; ``key`` names U's pattern (a :class:`ConstrainedPattern`: the same key, the
+        same pattern). The symbolic analysis is made once per key, so no conversion, triangle
+        extraction or pattern comparison is paid per solve."""
+        b = np.asarray(b, dtype=float)
+        t0 = time.perf_counter()
+        if self.method == "ldl":
+            try:
+                if self._solver is not None and self._pattern is key:
+                    self._solver.update(U, upper=True)
+                    self.stats["ldl_update"] += 1
+                else:
+                    self._solver = qdldl.Solver(U, upper=True)
+                    self._pattern, self._keys = key, None
+                    self.stats["ldl_fresh"] += 1
+                t1 = time.perf_counter()
+                self.times["factorisation"] += t1 - t0
+                x = self._solver.solve(b)
+                scale = max(float(np.abs(b).max(initial=0.0)), 1e-300)
+                Kx = U @ x + U.T @ x - diag * x
+                ok = np.all(np.isfinite(x)) and np.abs(Kx - b).max(initial=0.0) <= self.rtol * scale
+                self.times["solve"] += time.perf_counter() - t1
+                if ok:
+                    return x
+            except (ValueError, RuntimeError):
+                self._solver, self._pattern, self._keys = None, None, None  # not reused after a failure
+            self.stats["fallback"] += 1
+            t0 = time.perf_counter()
+        else:
+            self.stats["superlu"] += 1
+        x = superlu_solve(U + sp.triu(U, k=1).T, b)
+        self.times["factorisation"] += time.perf_counter() - t0
+        return x
+
     def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
         """x with K x = b; LDLᵀ where it is accurate, SuperLU otherwise."""
         b = np.asarray(b, dtype=float)
@@ -134,22 +169,43 @@ class SymmetricSolver:
         return x
 
 
-def constrain(K: sp.csr_matrix, fixed: np.ndarray, diag_value: float) -> sp.csr_matrix:
-    """K with the rows and columns of ``fixed`` dofs zeroed (kept as explicit zeros) and
-    ``diag_value`` on their diagonal: a symmetric system of unchanged sparsity pattern. With
-    b[fixed] = diag_value · x_c and b[free] = b_f − K_fc x_c (the prescribed values moved to
-    the right-hand side) its solution is x_c on the fixed dofs and the reduced solution on the
-    free ones. ``K`` must store its whole diagonal."""
-    K = K.tocsr(copy=True)
-    K.sort_indices()
-    n = K.shape[0]
-    is_fixed = np.zeros(n, dtype=bool)
-    is_fixed[fixed] = True
-    rows = np.repeat(np.arange(n), np.diff(K.indptr))
-    drop = is_fixed[rows] | is_fixed[K.indices]
-    K.data[drop] = 0.0
-    diag = np.flatnonzero((rows == K.indices) & is_fixed[rows])
-    if diag.size != np.count_nonzero(is_fixed):
-        raise ValueError("constrain: the matrix must store every diagonal entry of the fixed dofs")
-    K.data[diag] = diag_value
-    return K
+class ConstrainedPattern:
+    """The upper triangle of a symmetric matrix stored on a fixed CSR pattern (both triangles,
+    sorted indices), with the rows and columns of constrained dofs zeroed (kept as explicit zeros) and a
+    value on their diagonal, built by indexing alone. With b[fixed] = diag_value · x_c and
+    b[free] = b_f − K_fc x_c (the prescribed values moved to the right-hand side) the solution
+    is x_c on the fixed dofs and the reduced solution on the free ones.
+
+    The CSR arrays of the lower triangle (row j, columns i ≤ j) are the CSC arrays of the
+    upper triangle (column j, rows i ≤ j), so the upper matrix is ``data[lower]`` on index
+    arrays made once; its index arrays stay the same objects for every matrix, which lets
+    :meth:`SymmetricSolver.solve_upper` reuse its analysis without comparing patterns.
+    """
+
+    def __init__(self, indptr: np.ndarray, indices: np.ndarray):
+        n = indptr.size - 1
+        rows = np.repeat(np.arange(n), np.diff(indptr))
+        if np.any(np.diff(indices.astype(np.int64) + rows.astype(np.int64) * n) <= 0):
+            raise ValueError("ConstrainedPattern: the CSR indices must be sorted and unique")
+        self.n = n
+        self.lower = np.flatnonzero(indices <= rows)
+        self._row = indices[self.lower].astype(np.int64)  # row of the upper entry
+        self._col = rows[self.lower]  # its column
+        self._indptr = np.concatenate([[0], np.cumsum(np.bincount(self._col, minlength=n))]).astype(np.int32)
+        self._indices = self._row.astype(np.int32)
+        diag = np.flatnonzero(self._row == self._col)
+        if diag.size != n:
+            raise ValueError("ConstrainedPattern: the pattern must store every diagonal entry")
+        self.diag = diag  # positions of the diagonal in the upper data (column order: dof order)
+
+    def upper(self, data: np.ndarray, fixed: np.ndarray, diag_value: float) -> tuple:
+        """(U, diagonal) of the matrix holding CSR ``data`` with the rows and columns of
+        ``fixed`` zeroed and ``diag_value`` on their diagonal (explicit zeros kept)."""
+        u = data[self.lower]
+        if fixed.size:
+            is_fixed = np.zeros(self.n, dtype=bool)
+            is_fixed[fixed] = True
+            u[is_fixed[self._row] | is_fixed[self._col]] = 0.0
+            u[self.diag[fixed]] = diag_value
+        U = sp.csc_matrix((u, self._indices, self._indptr), shape=(self.n, self.n))
+        return U, u[self.diag]

@@ -27,7 +27,7 @@ import numpy as np
 from ..model.material import Material
 from .assembly import Discretisation, positive_jacobian
 from .contact import RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
-from .linsolve import SymmetricSolver, constrain
+from .linsolve import ConstrainedPattern, SymmetricSolver
 from .mesh import build_mesh
 from .plasticity import PlasticState, stress_and_tangent, stress_update
 from .segment_penalty import SegmentPenalty
@@ -647,6 +647,7 @@ class IndentationSolver(CycleLegs):
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "contact": 0.0, "linear": 0.0,
                        "line_search": 0.0}
         self._diag_slots = self.disc.slots(np.arange(nd), np.arange(nd))
+        self._upper = ConstrainedPattern(*self.disc.csr_pattern)
         self._nd = nd
         self.k_penalty = None
         if self.options.penalty is not None:
@@ -811,7 +812,8 @@ class IndentationSolver(CycleLegs):
             rhs = -r - K @ du_c
             scale = float(np.abs(data[self._diag_slots]).mean())
             rhs[fixed] = scale * du_c[fixed]
-            du = self.linear.solve(constrain(K, fixed, scale), rhs)
+            U, diag = self._upper.upper(data, fixed, scale)
+            du = self.linear.solve_upper(U, diag, rhs, self._upper)
             du[fixed] = du_c[fixed]
             du = self._rotate(du, frames)
             t4 = time.perf_counter()

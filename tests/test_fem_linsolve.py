@@ -6,7 +6,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from spherecontact.fem.contact import RigidObstacle
-from spherecontact.fem.linsolve import SymmetricSolver, constrain
+from spherecontact.fem.linsolve import ConstrainedPattern, SymmetricSolver
 from spherecontact.fem.solver import IndentationSolver, SolverOptions
 from spherecontact.model import Material
 
@@ -59,21 +59,63 @@ def test_saddle_point_falls_back_to_superlu():
     assert s.stats["fallback"] == 1
 
 
-def test_constrain_keeps_the_pattern_and_the_reduced_solution():
+def _full(U, diag):
+    return (U + U.T - sp.diags(diag)).toarray()
+
+
+def test_constrained_pattern_keeps_the_pattern_and_the_reduced_solution():
+    """The upper triangle taken by indexing the CSR data: symmetric, the fixed rows and
+    columns zeroed with diag_value on their diagonal, and the reduced problem's solution."""
     K = _laplacian(6)
+    K.sort_indices()
     n = K.shape[0]
     fixed = np.array([0, 7, 20])
     free = np.setdiff1d(np.arange(n), fixed)
     b = np.linspace(1.0, 2.0, n)
-    Kc = constrain(K, fixed, 3.0)
-    assert Kc.nnz == K.nnz
+    pattern = ConstrainedPattern(K.indptr, K.indices)
+    U, diag = pattern.upper(K.data, fixed, 3.0)
+    assert U.nnz == (K.nnz + n) // 2  # explicit zeros kept: the pattern never changes
+    Kc = _full(U, diag)
+    expected = K.toarray()
+    expected[fixed, :] = 0.0
+    expected[:, fixed] = 0.0
+    expected[fixed, fixed] = 3.0
+    assert np.array_equal(Kc, expected)
     x_c = np.array([0.25, -0.5, 1.0])
     rhs = b - K[:, fixed] @ x_c
     rhs[fixed] = 3.0 * x_c
-    x = spla.spsolve(Kc.tocsc(), rhs)
+    x = SymmetricSolver("ldl").solve_upper(U, diag, rhs, pattern)
     assert np.allclose(x[fixed], x_c)
     reduced = spla.spsolve(K[free][:, free].tocsc(), b[free] - K[free][:, fixed] @ x_c)
     assert np.allclose(x[free], reduced, rtol=1e-12)
+
+
+def test_constrained_pattern_refuses_a_pattern_without_its_diagonal():
+    K = sp.csr_matrix(np.array([[0.0, 1.0], [1.0, 2.0]]))
+    K.eliminate_zeros()
+    with pytest.raises(ValueError, match="diagonal"):
+        ConstrainedPattern(K.indptr, K.indices)
+
+
+def test_solve_upper_reuses_its_analysis_per_key_and_falls_back_on_a_zero_pivot():
+    K = _laplacian(8)
+    K.sort_indices()
+    pattern = ConstrainedPattern(K.indptr, K.indices)
+    b = np.ones(K.shape[0])
+    s = SymmetricSolver("ldl")
+    none = np.zeros(0, dtype=int)
+    x1 = s.solve_upper(*pattern.upper(K.data, none, 1.0), b, pattern)
+    x2 = s.solve_upper(*pattern.upper(2.0 * K.data, none, 1.0), b, pattern)
+    assert np.allclose(x2, 0.5 * x1, rtol=1e-10)
+    assert s.stats == {"ldl_fresh": 1, "ldl_update": 1, "fallback": 0, "superlu": 0}
+    # a zero diagonal entry first (LDLᵀ without pivoting breaks down): SuperLU answers
+    A = K.copy()
+    A.data[(np.repeat(np.arange(A.shape[0]), np.diff(A.indptr)) == A.indices) & (A.indices == 0)] = 0.0
+    U, diag = pattern.upper(A.data, none, 1.0)
+    s = SymmetricSolver("ldl")
+    x = s.solve_upper(U, diag, b, pattern)
+    assert np.abs(A @ x - b).max() < 1e-10
+    assert s.stats["fallback"] == 1
 
 
 def test_bad_method_is_named():
