@@ -19,6 +19,16 @@ properties are ratios. Every parameter is checked against its range, sets must
 be disjoint, and each case gets a readable name (``flat-pp-E1000-nu0.3``).
 Parameters and ranges are in :data:`PARAMETERS`; ``data/README.md`` documents
 the format.
+
+A case the FE cannot finish as designed is replaced in a ``[replace]`` table, by
+its name, with a reason and the parameters that change (``h_max``, ``cycles``)::
+
+    [replace."rsphere4-pp-E3000-nu0.3"]
+    h_max = 0.16
+    reason = "inverted element at h/R 0.174 (Lagrangian mesh at the contact edge)"
+
+The original case leaves the campaign (its stored run becomes superseded) and the
+replacement carries ``replaces`` = (original name, reason) into the reports.
 """
 
 from __future__ import annotations
@@ -131,7 +141,9 @@ _FROM_BODY1 = {"nu2": "nu", "K2_over_sigma_y1": "K_over_sigma_y", "n2": "n"}
 OPTION_NAMES = tuple(f.name for f in fields(SolverOptions) if f.name != "max_wall_s")
 #: keys of an entry besides PARAMETERS
 _ENTRY_KEYS = ("options", "cycles", "sample")
-_SETS_RESERVED = ("campaign", "defaults", "flow_curves")
+_SETS_RESERVED = ("campaign", "defaults", "flow_curves", "replace")
+#: what a ``[replace]`` entry may change (besides its required ``reason``)
+REPLACEABLE = ("h_max", "cycles")
 #: significant digits of a tabulated Voce-type curve. The table is the run's input, hashed
 #: into its key, and NumPy's SIMD exp/log/power differ in the last bit between CPUs (the
 #: keys of campaign v2's 12 Voce runs changed on another machine with the same code and
@@ -170,6 +182,8 @@ class Case:
     params: dict
     inputs: dict
     max_wall_s: float
+    #: (name of the designed case this one replaces, reason), or () for a designed case
+    replaces: tuple = ()
     key: str = field(init=False)
 
     def __post_init__(self):
@@ -465,7 +479,8 @@ def _expand(entry: dict, where: str) -> list[dict]:
             for point in itertools.product(*axes) for sampled in _sample(entry, where)]
 
 
-def _cases_of_set(set_name: str, entries, defaults: dict, curves: dict | None = None) -> list[Case]:
+def _cases_of_set(set_name: str, entries, defaults: dict, curves: dict | None = None,
+                  replace: dict | None = None) -> list[Case]:
     if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
         hint = "; parameters go in [defaults] or in entries" if set_name in PARAMETERS else ""
         raise ValueError(f"top-level key {set_name!r} must be a set, an array of tables "
@@ -478,10 +493,39 @@ def _cases_of_set(set_name: str, entries, defaults: dict, curves: dict | None = 
             raise ValueError(f"{where}: options must be a table of solver options")
         for point in _expand(entry, where):
             p, options = _resolve(point, defaults, where, curves)
+            name, replaces = _name(p, defaults), ()
+            if name in (replace or {}):
+                change = {k: v for k, v in replace[name].items() if k != "reason"}
+                p, options = _resolve({**point, **change}, defaults, f"[replace.{name!r}]", curves)
+                replaces = (name, replace[name]["reason"])
+                replace[name] = {**replace[name], "_used": True}
+                name = _name(p, defaults)
             wall = p.pop("max_wall_s")
-            cases.append(Case(set=set_name, name=_name(p, defaults), entry=where, params=p,
-                              inputs=_inputs(p, options, curves), max_wall_s=wall))
+            cases.append(Case(set=set_name, name=name, entry=where, params=p,
+                              inputs=_inputs(p, options, curves), max_wall_s=wall, replaces=replaces))
     return cases
+
+
+def _check_replace(doc: dict) -> dict:
+    """The ``[replace]`` table: case name → {reason, and h_max and/or cycles}."""
+    table = doc.get("replace", {})
+    if not isinstance(table, dict):
+        raise ValueError("[replace] must be a table of case names")
+    for name, entry in table.items():
+        where = f"[replace.{name!r}]"
+        if not isinstance(entry, dict):
+            raise ValueError(f"{where} must be a table (reason, and {' or '.join(REPLACEABLE)})")
+        if not (isinstance(entry.get("reason"), str) and entry["reason"].strip()):
+            raise ValueError(f"{where}: a replacement needs a reason (a non-empty string)")
+        unknown = sorted(set(entry) - {"reason", *REPLACEABLE})
+        if unknown:
+            raise ValueError(f"{where}: {unknown[0]!r} cannot be replaced; allowed: "
+                             f"{', '.join(REPLACEABLE)}")
+        if len(entry) == 1:
+            raise ValueError(f"{where}: nothing to replace; give {' or '.join(REPLACEABLE)}")
+        if "cycles" in entry:
+            _check_cycles(entry["cycles"], where)
+    return {k: dict(v) for k, v in table.items()}
 
 
 def _check_unique(cases: list[Case]) -> None:
@@ -531,11 +575,15 @@ def parse_campaign(text: str, source: str = "<campaign>") -> Campaign:
         sets = [k for k in doc if k not in _SETS_RESERVED]
         if not sets:
             raise ValueError("no sets: add entries such as [[calibration]] and [[validation]]")
+        replace = _check_replace(doc)
         cases = []
         for name in sets:
             if not name.replace("_", "").replace("-", "").isalnum():
                 raise ValueError(f"set name {name!r} must be letters, digits, '_' or '-'")
-            cases += _cases_of_set(name, doc[name], defaults, curves)
+            cases += _cases_of_set(name, doc[name], defaults, curves, replace)
+        unused = [n for n, e in replace.items() if not e.get("_used")]
+        if unused:
+            raise ValueError(f"[replace.{unused[0]!r}]: no case of the campaign has that name")
         _check_unique(cases)
     except ValueError as err:
         raise ValueError(f"{source}: {err}") from None

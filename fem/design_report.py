@@ -75,6 +75,14 @@ def write_markdown(path: Path, info: dict, source: str) -> None:
     for s, rng in info["ranges"].items():
         cells = [f"{rng[k][0]:.3g} – {rng[k][1]:.3g}" if k in rng else "—" for k, _, _ in AXES]
         lines.append(f"| {s} | " + " | ".join(cells) + " |")
+    if info.get("replaced"):
+        lines += ["", "## Replaced cases", "",
+                  "Cases the FE could not finish as designed, replaced in the campaign's `[replace]` "
+                  "table (the designed run stays out of calibration and validation).", "",
+                  "| set | designed case | replaced by | h_max (of the smaller radius) | state | reason |",
+                  "|---|---|---|---|---|---|"]
+        lines += [f"| {r['set']} | {r['designed']} | {r['name']} | {r['h_max']:g} | {r['state']} | "
+                  f"{r['reason']} |" for r in info["replaced"]]
     lines += ["", "![design](design.png)", ""]
     path.write_text("\n".join(lines))
 
@@ -131,6 +139,9 @@ def main(argv=None) -> int:
     db = _open_db(Path(args.db))
     info = table(cases, db)
     info["points"] = [{"set": c.set, "scene": c.scene, "name": c.name, **point(c)} for c in cases]
+    info["replaced"] = [{"set": c.set, "designed": c.replaces[0], "name": c.name, "reason": c.replaces[1],
+                         "h_max": c.params["h_max"], "state": _state(db, c.key)}
+                        for c in cases if c.replaces]
     (out / "design.json").write_text(json.dumps(info, indent=1, default=float) + "\n")
     write_markdown(out / "design.md", info, args.campaign)
     plot(out / "design.png", cases)

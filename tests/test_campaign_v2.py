@@ -124,7 +124,12 @@ def test_shipped_v2_design():
     cal, val = c.select({"calibration"}), c.select({"validation"})
     assert len(cal) >= 80 and len(val) >= 30
     assert not {x.key for x in cal} & {x.key for x in val}
-    assert all(x.params["h_max"] == 0.3 and len(x.inputs["unload_at"]) == 4 for x in c.cases)
+    designed = [x for x in c.cases if not x.replaces]
+    assert all(x.params["h_max"] == 0.3 and len(x.inputs["unload_at"]) == 4 for x in designed)
+    # a replaced case says why, and is short of the design only where the FE stops
+    replaced = [x for x in c.cases if x.replaces]
+    assert len(replaced) <= 6 and all(x.replaces[1] for x in replaced)
+    assert all(0.04 <= x.params["h_max"] <= 0.3 for x in replaced)
     metals = {x.params["flow_curve"] for x in val if x.params["flow_curve"]}
     assert len(metals) >= 3 and not any(x.params["flow_curve"] for x in cal)
     ratios = {round(x.params.get("indenter_radius", x.params.get("radius2", 1)), 3) for x in val}
@@ -143,3 +148,36 @@ def test_plan_runs_the_cheapest_cases_first():
                                   'E2_over_E1 = 3\noptions = { penalty = 100 }\n').cases
     order = [c.name.split("-")[0] + "-" + c.name.split("-")[2] for c in plan(list(cases), None)]
     assert order == ["flat-E10", "flat-E300", "two-E30", "flat-E10000"]  # cost 3, 17, 55, 100
+
+
+GRID = ('[defaults]\nh_max = 0.3\ncycles = [0.01, 0.1, 0.3]\n'
+        '[[s]]\nscene = "flat"\nE_over_sigma_y = [100, 1000]\n')
+
+
+def test_a_replaced_case_leaves_the_campaign_and_its_replacement_says_why():
+    designed = {c.name: c for c in parse_campaign(GRID).cases}
+    text = GRID + '[replace."flat-pp-E1000-nu0.3"]\nh_max = 0.2\nreason = "inverted element"\n'
+    cases = {c.name: c for c in parse_campaign(text).cases}
+    assert set(cases) == {"flat-pp-E100-nu0.3", "flat-pp-E1000-nu0.3-h0.2"}
+    new = cases["flat-pp-E1000-nu0.3-h0.2"]
+    assert new.replaces == ("flat-pp-E1000-nu0.3", "inverted element")
+    assert new.inputs["h_max"] == 0.2 and new.inputs["unload_at"] == [0.01, 0.1]
+    assert cases["flat-pp-E100-nu0.3"].key == designed["flat-pp-E100-nu0.3"].key
+    assert cases["flat-pp-E100-nu0.3"].replaces == ()
+    # cycles alone: same name, another key
+    text = GRID + '[replace."flat-pp-E100-nu0.3"]\ncycles = [0.01, 0.1]\nreason = "x"\n'
+    (c,) = [c for c in parse_campaign(text).cases if c.name == "flat-pp-E100-nu0.3"]
+    assert c.key != designed[c.name].key and c.inputs["unload_at"] == [0.01, 0.1]
+
+
+@pytest.mark.parametrize("entry, message", [
+    ('[replace."flat-pp-E10-nu0.3"]\nh_max = 0.2\nreason = "x"\n', "no case of the campaign"),
+    ('[replace."flat-pp-E100-nu0.3"]\nh_max = 0.2\n', "needs a reason"),
+    ('[replace."flat-pp-E100-nu0.3"]\nreason = "x"\n', "nothing to replace"),
+    ('[replace."flat-pp-E100-nu0.3"]\nnu = 0.2\nreason = "x"\n', "'nu' cannot be replaced"),
+    ('[replace."flat-pp-E100-nu0.3"]\nh_max = 2\nreason = "x"\n', "h_max"),
+    ('[replace."flat-pp-E100-nu0.3"]\ncycles = [0.3, 0.1]\nreason = "x"\n', "cycles must increase"),
+])
+def test_bad_replacements_are_named(entry, message):
+    with pytest.raises(ValueError, match=message):
+        parse_campaign(GRID + entry)
