@@ -4,8 +4,9 @@
 
 The campaign file (:mod:`.design`) expands to cases; cases whose key is already
 in the database are skipped (``--retry-failed`` / ``--retry-stopped`` rerun
-those). The rest run in local worker processes (``--workers``, default: one per
-core) or on a Dask cluster (``--scheduler tcp://host:port``). Workers send the
+those, ``--refresh-start`` runs made with an older, larger first step). The
+rest run in local worker processes (``--workers``, default: one per core) or on
+a Dask cluster (``--scheduler tcp://host:port``). Workers send the
 ``RunResult`` back; the main process is the only writer and appends each run
 as it finishes (:func:`spherecontact.data.append_run`, crash-safe), so a killed
 campaign loses at most the runs in flight. A run that raises is recorded under
@@ -39,7 +40,7 @@ from pathlib import Path
 
 from ..data import Database, Record, append_run, compact, remove_entries, remove_stale_temporaries
 from .design import Campaign, Case, load_campaign
-from .io import provenance, run_indentation
+from .io import old_plastic_start, provenance, run_indentation
 from .solver import RunResult
 
 __all__ = ["Outcome", "execute", "plan", "superseded", "prune", "run_campaign", "summarize",
@@ -233,12 +234,28 @@ def expected_cost(case: Case) -> float:
     return factor * p["E_over_sigma_y"] ** 0.5 * p.get("mesh_density", 1.0) ** 2
 
 
+def old_start(db: Database, key: str) -> bool:
+    """True when the run stored under ``key`` began with a larger first step than today's
+    solver takes, across first yield (``fem.io.old_plastic_start``): its first increments carry
+    the transient ``fem.io.reference_mask`` leaves out, and a re-run would not."""
+    run = db.run(key)
+    h = run.h[run.loading]
+    h = h[h > 0]
+    return h.size > 0 and old_plastic_start(db.record(key).inputs, float(h[0]))
+
+
 def plan(cases: list[Case], db: Database | None, retry_failed: bool = False,
-         retry_stopped: bool = False) -> list[Case]:
-    """The cases to run: missing ones, plus failed / stopped ones when asked to retry, the
+         retry_stopped: bool = False, refresh_start: bool = False) -> list[Case]:
+    """The cases to run: missing ones, plus failed / stopped ones when asked to retry, and
+    stored runs with an old first step (:func:`old_start`) when asked to refresh them; the
     cheapest first (:func:`expected_cost`), so an interrupted campaign has done the most runs."""
     rerun = {"missing"} | ({"failed"} if retry_failed else set()) | ({"stopped"} if retry_stopped else set())
-    return sorted((c for c in cases if _state(db, c.key) in rerun), key=expected_cost)
+
+    def wanted(c: Case) -> bool:
+        state = _state(db, c.key)
+        return state in rerun or (refresh_start and state in ("converged", "stopped")
+                                  and old_start(db, c.key))
+    return sorted(filter(wanted, cases), key=expected_cost)
 
 
 def superseded(campaign: Campaign, db: Database | None) -> list[Record]:
@@ -335,7 +352,7 @@ def _running_reporter(bar, folder: Path, every_s: float = 300.0):
 def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = None,
                  workers: int | None = None, scheduler: str | None = None,
                  retry_failed: bool = False, retry_stopped: bool = False,
-                 runner: Runner = execute) -> dict:
+                 refresh_start: bool = False, runner: Runner = execute) -> dict:
     """Run the selected cases not yet in the database; return the summary (also written as JSON).
 
     ``workers = 0`` runs in this process; ``scheduler`` a Dask cluster instead of
@@ -350,7 +367,7 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
     remove_stale_temporaries(db_path)
     selected = campaign.select(sets, only)
     db = _open_db(db_path)
-    todo = plan(selected, db, retry_failed, retry_stopped)
+    todo = plan(selected, db, retry_failed, retry_stopped, refresh_start)
     workers = (os.cpu_count() or 1) if workers is None else workers
     backend = f"dask {scheduler}" if scheduler else (
         "in-process" if workers == 0 else f"{workers} local worker process(es)")
@@ -382,10 +399,15 @@ def run_campaign(campaign: Campaign, db_path, *, sets=None, only: str | None = N
                               f"h = {_reached(out):.6g}, short of the stored run: the stored run is "
                               f"kept ({out.reason})")
                     continue
+                if present == "converged" and out.status != "converged":  # a refresh that failed
+                    bar.update(1)
+                    _log(bar, f"[{done}/{len(todo)}] {case.set} {case.name}: the re-run {out.status} "
+                              f"({out.reason}): the stored converged run is kept")
+                    continue
                 try:
                     append_run(db_path, record, out.result, out.provenance, traceback=out.traceback,
                                campaign_text=campaign.text, campaign_source=campaign.source,
-                               replace=present == "stopped")
+                               replace=present in ("stopped", "converged"))
                 except ValueError as err:  # a result the writer rejects fails its case, not the campaign
                     out = _unwritable(db_path, record, present, err, campaign)
                 bar.update(1)
@@ -469,6 +491,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--retry-failed", action="store_true", help="rerun cases recorded as failed")
     p.add_argument("--retry-stopped", action="store_true",
                    help="rerun cases stored as stopped (e.g. after raising max_wall_s) and replace them")
+    p.add_argument("--refresh-start", action="store_true",
+                   help="rerun stored runs whose first step was larger than today's solver takes "
+                        "(their first increments are left out as a transient) and replace them "
+                        "when the re-run converges")
     p.add_argument("--prune", action="store_true",
                    help="remove the database entries no case of the campaign produces (superseded "
                         "inputs or options), print them, and run nothing")
@@ -513,7 +539,8 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         summary = run_campaign(campaign, args.db, sets=sets, only=args.only, workers=args.workers,
                                scheduler=args.scheduler, retry_failed=args.retry_failed,
-                               retry_stopped=args.retry_stopped)
+                               retry_stopped=args.retry_stopped,
+                               refresh_start=args.refresh_start)
     except ValueError as err:
         print(f"{ENTRY_POINT}: error: {err}", file=sys.stderr)
         return 2

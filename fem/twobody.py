@@ -25,6 +25,7 @@ dissipation of each body.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from types import SimpleNamespace
@@ -542,6 +543,12 @@ class TwoBodySolver(CycleLegs):
     def _pair_modulus(self) -> float:
         e1, e2 = (b.material.E_prime for b in self.bodies)
         return 1.0 / (1.0 / e1 + 1.0 / e2)
+
+    def _relative_radius(self) -> float:
+        return 1.0 / sum(1.0 / b.radius for b in self.bodies)
+
+    def _deformable_materials(self) -> list:
+        return [b.material for b in self.bodies if math.isfinite(b.material.E)]
 
     def _solved_contact(self, solved) -> tuple[float, bool]:
         return float(solved[9]), bool(np.any(solved[3]))
