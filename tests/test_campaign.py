@@ -400,3 +400,36 @@ def test_a_retry_that_gets_no_further_keeps_the_stored_stopped_run(tmp_path):
         assert summary["ran"] == 1 and summary["total"]["stopped"] == 1
         db = Database(db_path)
         assert db.failed() == [] and np.array_equal(db.run(rec.key).h, h_stored)
+
+
+def test_refresh_start_reruns_runs_made_with_an_old_first_step(tmp_path, monkeypatch):
+    """A run whose first step crossed first yield (made before the first-yield bound) is
+    re-run by --refresh-start and replaced when the re-run converges; a run with today's first
+    step is not; a re-run that fails keeps the stored converged run."""
+    from spherecontact.fem import solver as fs
+    from spherecontact.fem.io import start_steps
+
+    body = '[[calibration]]\nscene = "flat"\nE_over_sigma_y = [1000, 10]\n'
+    c = parse_campaign(tiny(body, h_max=0.002))
+    db_path = tmp_path / "ref.h5"
+    today = fs.first_step
+    with monkeypatch.context() as m:  # the rule before the bound: no first-yield cut
+        m.setattr(fs, "first_step", lambda opt, length, scale, h_y: today(opt, length, scale, 1.0))
+        fc.run_campaign(c, db_path, workers=0)
+    db = Database(db_path)
+    stiff, soft = (next(r for r in db.records() if f"E{e}-" in r.case) for e in (1000, 10))
+    h1_old = db.run(stiff.key).h[0]
+    assert h1_old > start_steps(stiff.inputs)[0] and fc.old_start(db, stiff.key)
+    assert not fc.old_start(db, soft.key)  # its first increment stayed elastic
+    assert [x.key for x in fc.plan(list(c.cases), db, refresh_start=True)] == [stiff.key]
+
+    def failing(case):
+        return fc.Outcome(case.key, "failed", "RuntimeError: boom", 0.0, traceback="Traceback ...")
+
+    summary = fc.run_campaign(c, db_path, workers=0, refresh_start=True, runner=failing)
+    assert summary["ran"] == 1 and Database(db_path).run(stiff.key).h[0] == h1_old
+    summary = fc.run_campaign(c, db_path, workers=0, refresh_start=True)
+    db = Database(db_path)
+    assert summary["ran"] == 1 and summary["total"]["converged"] == 2 and len(db) == 2
+    assert db.run(stiff.key).h[0] == start_steps(stiff.inputs)[0] < h1_old
+    assert fc.plan(list(c.cases), db, refresh_start=True) == []
