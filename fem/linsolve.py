@@ -112,49 +112,35 @@ class SymmetricSolver:
         ``diag``; ``key`` names U's pattern (a :class:`ConstrainedPattern`: the same key, the
         same pattern). The symbolic analysis is made once per key, so no conversion, triangle
         extraction or pattern comparison is paid per solve."""
-        b = np.asarray(b, dtype=float)
-        t0 = time.perf_counter()
-        if self.method == "ldl":
-            try:
-                if self._solver is not None and self._pattern is key:
-                    self._solver.update(U, upper=True)
-                    self.stats["ldl_update"] += 1
-                else:
-                    self._solver = qdldl.Solver(U, upper=True)
-                    self._pattern, self._keys = key, None
-                    self.stats["ldl_fresh"] += 1
-                t1 = time.perf_counter()
-                self.times["factorisation"] += t1 - t0
-                x = self._solver.solve(b)
-                scale = max(float(np.abs(b).max(initial=0.0)), 1e-300)
-                Kx = U @ x + U.T @ x - diag * x
-                ok = np.all(np.isfinite(x)) and np.abs(Kx - b).max(initial=0.0) <= self.rtol * scale
-                self.times["solve"] += time.perf_counter() - t1
-                if ok:
-                    return x
-            except (ValueError, RuntimeError):
-                self._solver, self._pattern, self._keys = None, None, None  # not reused after a failure
-            self.stats["fallback"] += 1
-            t0 = time.perf_counter()
-        else:
-            self.stats["superlu"] += 1
-        x = superlu_solve(U + sp.triu(U, k=1).T, b)
-        self.times["factorisation"] += time.perf_counter() - t0
-        return x
+        def factor():
+            if self._solver is not None and self._pattern is key:
+                self._solver.update(U, upper=True)
+                self.stats["ldl_update"] += 1
+            else:
+                self._solver = qdldl.Solver(U, upper=True)
+                self._pattern, self._keys = key, None
+                self.stats["ldl_fresh"] += 1
+        return self._checked(b, factor, lambda x: U @ x + U.T @ x - diag * x,
+                             lambda: U + sp.triu(U, k=1).T)
 
     def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
         """x with K x = b; LDLᵀ where it is accurate, SuperLU otherwise."""
+        K = sp.csc_matrix(K)
+        return self._checked(b, lambda: self._factor(K), lambda x: K @ x, lambda: K)
+
+    def _checked(self, b: np.ndarray, factor, matvec, full) -> np.ndarray:
+        """``factor()`` then the LDLᵀ solution when its residual ‖matvec(x) − b‖∞ ≤ rtol ‖b‖∞,
+        otherwise SuperLU's on ``full()`` (the whole matrix); times and counts recorded."""
         b = np.asarray(b, dtype=float)
         t0 = time.perf_counter()
         if self.method == "ldl":
-            K = sp.csc_matrix(K)
             try:
-                self._factor(K)
+                factor()
                 t1 = time.perf_counter()
                 self.times["factorisation"] += t1 - t0
                 x = self._solver.solve(b)
                 scale = max(float(np.abs(b).max(initial=0.0)), 1e-300)
-                ok = np.all(np.isfinite(x)) and np.abs(K @ x - b).max(initial=0.0) <= self.rtol * scale
+                ok = np.all(np.isfinite(x)) and np.abs(matvec(x) - b).max(initial=0.0) <= self.rtol * scale
                 self.times["solve"] += time.perf_counter() - t1
                 if ok:
                     return x
@@ -164,7 +150,7 @@ class SymmetricSolver:
             t0 = time.perf_counter()
         else:
             self.stats["superlu"] += 1
-        x = superlu_solve(K, b)
+        x = superlu_solve(full(), b)
         self.times["factorisation"] += time.perf_counter() - t0
         return x
 

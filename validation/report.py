@@ -71,10 +71,10 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
     ]
     transient = [c for c in validation if not np.array_equal(c.reference, c.loading)]
     if transient:
-        lines.append(f"* FE increments: {len(transient)} of the runs began with a first step above the "
-                     f"strain bound Δε²·R; their increments below {START_TRANSIENT:g}× that step (its "
-                     "transient, `fem.io.reference_mask`, data/README.md) are left out of every "
-                     "comparison.")
+        lines.append(f"* FE increments: {len(transient)} of the runs began with a first step larger than "
+                     f"today's solver takes, across first yield; their increments below "
+                     f"{START_TRANSIENT:g}× that step (its transient, `fem.io.reference_mask`, "
+                     "data/README.md) are left out of every comparison.")
     if skipped:
         lines.append(f"* Not compared (no converged curve): {', '.join(skipped)}.")
     return lines
