@@ -498,7 +498,6 @@ def _cases_of_set(set_name: str, entries, defaults: dict, curves: dict | None = 
                 change = {k: v for k, v in replace[name].items() if k != "reason"}
                 p, options = _resolve({**point, **change}, defaults, f"[replace.{name!r}]", curves)
                 replaces = (name, replace[name]["reason"])
-                replace[name] = {**replace[name], "_used": True}
                 name = _name(p, defaults)
             wall = p.pop("max_wall_s")
             cases.append(Case(set=set_name, name=name, entry=where, params=p,
@@ -581,7 +580,8 @@ def parse_campaign(text: str, source: str = "<campaign>") -> Campaign:
             if not name.replace("_", "").replace("-", "").isalnum():
                 raise ValueError(f"set name {name!r} must be letters, digits, '_' or '-'")
             cases += _cases_of_set(name, doc[name], defaults, curves, replace)
-        unused = [n for n, e in replace.items() if not e.get("_used")]
+        used = {c.replaces[0] for c in cases if c.replaces}
+        unused = [n for n in replace if n not in used]
         if unused:
             raise ValueError(f"[replace.{unused[0]!r}]: no case of the campaign has that name")
         _check_unique(cases)

@@ -77,8 +77,7 @@ from .solver import (
     RunResult,
     SolverOptions,
     check_unload_at,
-    first_step,
-    first_yield_approach,
+    start_of_loading,
 )
 from .twobody import TwoBodySolver
 
@@ -767,20 +766,15 @@ START_TRANSIENT = 10.0
 
 def start_steps(inputs: dict) -> tuple[float, float]:
     """(first loading step today's solver takes, approach of first yield) for a run of these
-    stored ``inputs`` (:func:`fem.solver.first_step`, :func:`fem.solver.first_yield_approach`)."""
+    stored ``inputs`` (:func:`fem.solver.start_of_loading`)."""
     opts = SolverOptions(**{k: v for k, v in (inputs.get("options") or {}).items()
                             if k in SolverOptions.__dataclass_fields__})
-    R1 = float(inputs["radius"])
     m1 = material_from_description(inputs["material"])
-    if "radius2" in inputs:  # two bodies: steps in units of the smaller radius
-        R2 = float(inputs["radius2"])
-        bodies = [m for m in (m1, material_from_description(inputs["material2"])) if math.isfinite(m.E)]
-        E_star = 1.0 / sum(1.0 / m.E_prime for m in bodies)
-        h_y = first_yield_approach(bodies, 1.0 / (1.0 / R1 + 1.0 / R2), E_star)
-        return first_step(opts, min(R1, R2), 1.0, h_y), h_y
-    R_ind = float(inputs.get("indenter_radius", math.inf))
-    h_y = first_yield_approach([m1], 1.0 / (1.0 / R1 + 1.0 / R_ind), m1.E_prime)
-    return first_step(opts, R1, min(1.0, R_ind / R1), h_y), h_y
+    if "radius2" in inputs:  # two bodies
+        return start_of_loading(opts, m1, float(inputs["radius"]), float(inputs["radius2"]),
+                                material_from_description(inputs["material2"]))
+    return start_of_loading(opts, m1, float(inputs["radius"]),
+                            float(inputs.get("indenter_radius", math.inf)))
 
 
 def old_plastic_start(inputs: dict, h1: float) -> bool:

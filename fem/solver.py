@@ -338,9 +338,23 @@ def first_yield_approach(materials, R_rel: float, E_star: float) -> float:
 def first_step(options: SolverOptions, length: float, scale: float, first_yield: float) -> float:
     """The first loading step (:meth:`CycleLegs._strain_step`): dh_first · s² · R, at most
     strain_increment² · s · R, and at most the approach of first yield (not below dh_min · R)."""
-    opt = options
-    step = min(opt.dh_first * scale**2, opt.strain_increment**2 * scale) * length
-    return min(step, max(first_yield, opt.dh_min * length))
+    step = min(options.dh_first * scale**2, options.strain_increment**2 * scale) * length
+    return min(step, max(first_yield, options.dh_min * length))
+
+
+def start_of_loading(options: SolverOptions, material: Material, radius: float,
+                     partner_radius: float, material2: Material | None = None) -> tuple[float, float]:
+    """(first loading step, approach of first yield) of a scene: ``material`` of ``radius``
+    against a rigid partner of ``partner_radius`` (inf: a flat; steps in units of the body's
+    radius, scaled by s = min(1, partner/radius)), or against a deformable ``material2`` of
+    ``partner_radius`` (two bodies: steps in units of the smaller radius, E* and R* of the pair)."""
+    R_rel = 1.0 / (1.0 / radius + 1.0 / partner_radius)
+    if material2 is None:
+        h_y = first_yield_approach([material], R_rel, material.E_prime)
+        return first_step(options, radius, min(1.0, partner_radius / radius), h_y), h_y
+    bodies = [m for m in (material, material2) if math.isfinite(m.E)]
+    h_y = first_yield_approach(bodies, R_rel, 1.0 / sum(1.0 / m.E_prime for m in bodies))
+    return first_step(options, min(radius, partner_radius), 1.0, h_y), h_y
 
 
 def check_unload_at(unload_at, h_max: float) -> np.ndarray:
@@ -426,7 +440,8 @@ class CycleLegs:
     ``F``, ``a``, ``a_nodes``, ``work_external``, ``dissipation``, ``energy_elastic``,
     ``branch``), ``_solve(run, h)`` (the converged increment or the exception),
     ``_commit(run, h, solved, branch)``, ``_solved_contact(solved)`` → (F, any contact),
-    ``_pair_modulus()`` → E* and ``_residual_surface(u)`` → (r, z) of the contact surface.
+    ``_pair_modulus()`` → E*, ``_start_of_loading()`` → (first step, approach of first yield;
+    :func:`start_of_loading`) and ``_residual_surface(u)`` → (r, z) of the contact surface.
     """
 
     def _walk(self, run: _RunState, h_max: float, unload: np.ndarray, targets=None) -> list[dict]:
@@ -513,7 +528,7 @@ class CycleLegs:
         """Largest loading step: strain_increment · a (times the step scale s), a the contact
         radius reached; before contact the first step dh_first · s² · R, cut to the step whose own
         Hertz radius √(R·dh) satisfies the same bound (dh = strain_increment² · s · R) and to the
-        approach of first yield (:meth:`_first_yield`, not below dh_min · R): the first step stays
+        approach of first yield (:func:`start_of_loading`, not below dh_min · R): the first step stays
         elastic and the elastic–plastic transition is crossed by steps that grow by ``growth``.
 
         A first step across the transition leaves the next increments biased, by more the stiffer
@@ -531,8 +546,7 @@ class CycleLegs:
         opt, R, s = self.options, self._length, self._step_scale
         if a_last > 0.0 and h > 0.0:
             return max(opt.strain_increment * a_last * s, opt.dh_min * R)
-        return first_step(opt, R, s, first_yield_approach(
-            self._deformable_materials(), self._relative_radius(), self._pair_modulus()))
+        return self._start_of_loading()[0]
 
     def _load_leg(self, run: _RunState, peak: float, targets=None) -> bool:
         """Load (elastic reloading first, below the largest approach reached) up to ``peak``."""
@@ -966,11 +980,8 @@ class IndentationSolver(CycleLegs):
     def _pair_modulus(self) -> float:
         return self.material.E / (1.0 - self.material.nu**2)  # rigid partner: E* = E'
 
-    def _relative_radius(self) -> float:
-        return 1.0 / (1.0 / self.radius + 1.0 / self.obstacle.radius)
-
-    def _deformable_materials(self) -> list:
-        return [self.material]
+    def _start_of_loading(self) -> tuple[float, float]:
+        return start_of_loading(self.options, self.material, self.radius, self.obstacle.radius)
 
     def _residual_surface(self, u: np.ndarray) -> np.ndarray:
         return self.X[:, self.surface] + self._nodal(u, self.surface)

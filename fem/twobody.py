@@ -25,7 +25,6 @@ dissipation of each body.
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 from types import SimpleNamespace
@@ -55,6 +54,7 @@ from .solver import (
     freeze_toggling,
     new_active_log,
     plastic_dissipation,
+    start_of_loading,
     stiffest_modulus,
     update_active_set,
 )
@@ -544,11 +544,9 @@ class TwoBodySolver(CycleLegs):
         e1, e2 = (b.material.E_prime for b in self.bodies)
         return 1.0 / (1.0 / e1 + 1.0 / e2)
 
-    def _relative_radius(self) -> float:
-        return 1.0 / sum(1.0 / b.radius for b in self.bodies)
-
-    def _deformable_materials(self) -> list:
-        return [b.material for b in self.bodies if math.isfinite(b.material.E)]
+    def _start_of_loading(self) -> tuple[float, float]:
+        b1, b2 = self.bodies
+        return start_of_loading(self.options, b1.material, b1.radius, b2.radius, b2.material)
 
     def _solved_contact(self, solved) -> tuple[float, bool]:
         return float(solved[9]), bool(np.any(solved[3]))
