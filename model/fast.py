@@ -14,6 +14,12 @@ as :attr:`ContactLaw.error` (relative, with a safety factor 2); the table is ref
 until it is below ``rtol``. Approaches outside [h_min, h_max] fall back to the exact
 solve, so every input gets an answer of known accuracy.
 
+Setup cost is the number of vectorised κ solves (an evaluation of the body responses has a
+fixed cost that dominates at a table's ~600 points): the inversion of the two table ends,
+one solve for the regular grid, one per pass of the kink search (sections per pass chosen
+for the fewest passes, warm-started between the bracket ends) and one for the nodes, the
+one-sided points at kinks and the error probes together (warm-started from the grid).
+
 Evaluation is a uniform bucket lookup (no binary search), one gather of the interval's
 polynomial coefficients, a Horner step and one exponential: no loops over contacts.
 
@@ -46,7 +52,8 @@ __all__ = ["ContactLaw", "contact_table"]
 DEFAULT_STEP = 0.02
 _ONE_SIDED = 1e-8  # offset in ln a for the one-sided slopes at kinks
 _KINK_TOL = 1e-11  # kink location tolerance in ln a
-_SECTIONS = 16     # points per pass of the kink search
+_KINK_POINTS = 1024  # points per pass of the kink search, shared by the kinks (≥ 16 each)
+_PROBES = (0.21, 0.5, 0.79)  # error probes: fractions of every interval in ln a
 _SAFETY = 2.0      # error bound = safety × largest error found at the probe points
 
 
@@ -54,6 +61,30 @@ def _hermite(y0, y1, d0, d1, ds):
     """Coefficients c0..c3 of y(t) = c0 + c1 t + c2 t² + c3 t³ on t ∈ [0, 1] (slopes in s)."""
     m0, m1 = d0 * ds, d1 * ds
     return np.stack([y0, m0, 3.0 * (y1 - y0) - 2.0 * m0 - m1, 2.0 * (y0 - y1) + m0 + m1], axis=1)
+
+
+def _take(st: UnifiedState, sel) -> UnifiedState:
+    """The states ``sel`` (slice or indices) of a batch of states."""
+    return UnifiedState(*(f[sel] for f in st))
+
+
+def _sections(width: float, kinks: int) -> int:
+    """Sections S per pass of the kink search: the fewest passes P that shrink brackets of
+    ``width`` to ``_KINK_TOL`` with at most ``_KINK_POINTS`` points (≥ 16 per kink), then
+    the fewest sections for P passes, width/S^P ≤ _KINK_TOL (1 % margin for rounding)."""
+    ratio = width / _KINK_TOL
+    if ratio <= 1.0:
+        return 2
+    most = max(_KINK_POINTS // kinks, 16)
+    passes = math.ceil(math.log(ratio) / math.log(most))
+    return min(math.ceil(1.01 * ratio ** (1.0 / passes)), most)
+
+
+def _log_slopes(st: UnifiedState):
+    """Slopes in s = ln h of ln F, ln a and φ = h_1/h: (d ln F/d ln a)/(d ln h/d ln a) etc."""
+    phi = st.h1 / st.h
+    return (st.dlnF_dlna / st.dlnh_dlna, 1.0 / st.dlnh_dlna,
+            phi * (st.dlnh1_dlna - st.dlnh_dlna) / st.dlnh_dlna)
 
 
 class ContactLaw:
@@ -114,6 +145,7 @@ class ContactLaw:
         a_lo, a_hi = self.pair.a_from_h(np.array([h_min, h_max]))
         self._lnX = (math.log(a_lo / Rs), math.log(a_hi / Rs))
         step = DEFAULT_STEP
+        self._u_grid = None
         for _ in range(4):
             kinks = self._build(step)
             self.error = self._measure()
@@ -136,63 +168,77 @@ class ContactLaw:
         return self.pair.state_at_a(a, self.pair.solve_u(a, u_guess))
 
     def _u_at(self, lnX):
-        """Warm start for the κ variable u = ln(ρ_2/ρ_1), interpolated from the last grid."""
+        """Warm start for the κ variable u = ln(ρ_2/ρ_1), interpolated from the last grid
+        (None before the first grid is solved)."""
         if self.pair.mode != "general" or self._u_grid is None:
             return None
         return np.interp(lnX, *self._u_grid)
 
     def _find_kinks(self, grid: np.ndarray, st: UnifiedState) -> np.ndarray:
-        """ln(a/R*) of every piece change of the pair between grid nodes, by bisection."""
+        """ln(a/R*) of every piece change of the pair between grid nodes, by multi-section:
+        one vectorised κ solve per pass, warm-started by u interpolated between the ends of
+        each bracket (u = ln(ρ_2/ρ_1) of the last pass)."""
         piece = st.piece
         j = np.nonzero(piece[1:] != piece[:-1])[0]
         if j.size == 0:
             return np.empty(0)
         lo, hi = grid[j], grid[j + 1]
+        u = self._u_of(st)
+        u_lo, u_hi = (None, None) if u is None else (u[j], u[j + 1])
         p_lo = piece[j][:, None]
-        frac = np.arange(1, _SECTIONS) / _SECTIONS
-        while np.max(hi - lo) > _KINK_TOL:  # multi-section: one vectorised solve per pass
+        n = _sections(float(np.max(hi - lo)), lo.size)
+        frac = np.arange(1, n) / n
+        rows = np.arange(lo.size)
+        while np.max(hi - lo) > _KINK_TOL:
             pts = lo[:, None] + (hi - lo)[:, None] * frac[None, :]
-            flat = pts.ravel()
-            changed = (self._state(flat, self._u_at(flat)).piece.reshape(pts.shape) != p_lo)
+            guess = None if u is None else (u_lo[:, None] + (u_hi - u_lo)[:, None] * frac[None, :]).ravel()
+            sp = self._state(pts.ravel(), guess)
+            changed = sp.piece.reshape(pts.shape) != p_lo
             first = np.where(changed.any(axis=1), np.argmax(changed, axis=1), frac.size)
-            rows = np.arange(lo.size)
-            new_lo = np.where(first > 0, pts[rows, np.maximum(first - 1, 0)], lo)
-            new_hi = np.where(first < frac.size, pts[rows, np.minimum(first, frac.size - 1)], hi)
-            lo, hi = new_lo, new_hi
+            below, above = np.maximum(first - 1, 0), np.minimum(first, frac.size - 1)
+            keep_lo, keep_hi = first == 0, first == frac.size
+            lo, hi = np.where(keep_lo, lo, pts[rows, below]), np.where(keep_hi, hi, pts[rows, above])
+            if u is not None:
+                up = self._u_of(sp).reshape(pts.shape)
+                u_lo = np.where(keep_lo, u_lo, up[rows, below])
+                u_hi = np.where(keep_hi, u_hi, up[rows, above])
         return hi
 
+    def _u_of(self, st: UnifiedState):
+        """u = ln(ρ_2/ρ_1) of solved states (None if the pair needs no κ solve)."""
+        return np.log(st.rho2 / st.rho1) if self.pair.mode == "general" else None
+
     def _build(self, step: float) -> np.ndarray:
-        """Nodes, kinks and Hermite coefficients for a regular step in ln(a/R*); returns kinks."""
+        """Nodes, kinks and Hermite coefficients for a regular step in ln(a/R*); returns kinks.
+
+        Nodes, the one-sided points next to every kink and the error probes of
+        :meth:`_measure` are solved together (one vectorised κ solve)."""
         lo_end, hi_end = self._lnX
         n = max(int(math.ceil((hi_end - lo_end) / step)), 1)
         reg = np.linspace(lo_end, hi_end, n + 1)
-        self._u_grid = None
-        st_reg = self._state(reg)
+        st_reg = self._state(reg, self._u_at(reg))  # warm from the coarser grid when refining
         if self.pair.mode == "general":
-            self._u_grid = (reg, np.log(st_reg.rho2 / st_reg.rho1))
+            self._u_grid = (reg, self._u_of(st_reg))
         kinks = self._find_kinks(reg, st_reg)
         if kinks.size:
             near = np.min(np.abs(reg[:, None] - kinks[None, :]), axis=1) < 0.25 * step
             near[[0, -1]] = False
             reg = reg[~near]
         lnX = np.unique(np.concatenate([reg, kinks]))
-        st = self._state(lnX, self._u_at(lnX))
+        k = np.nonzero(np.isin(lnX, kinks))[0]
+        probes = np.concatenate([lnX[:-1] + f * np.diff(lnX) for f in _PROBES])
+        m, nk = lnX.size, k.size
+        pts = np.concatenate([lnX, lnX[k] - _ONE_SIDED, lnX[k] + _ONE_SIDED, probes])
+        batch = self._state(pts, self._u_at(pts))
+        st = _take(batch, slice(0, m))
+        self._probe_state = _take(batch, slice(m + 2 * nk, None))
         # one-sided slopes at kinks: left limit for the interval ending there, right for the next
-        dF_l = st.dlnF_dlna / st.dlnh_dlna
-        da_l = 1.0 / st.dlnh_dlna
-        phi = st.h1 / st.h
-        dphi_l = phi * (st.dlnh1_dlna - st.dlnh_dlna) / st.dlnh_dlna
+        dF_l, da_l, dphi_l = _log_slopes(st)
         dF_r, da_r, dphi_r = dF_l.copy(), da_l.copy(), dphi_l.copy()
-        is_kink = np.isin(lnX, kinks)
-        if np.any(is_kink):
-            k = np.nonzero(is_kink)[0]
-            for sign, (dF, da, dphi) in ((-1.0, (dF_l, da_l, dphi_l)), (1.0, (dF_r, da_r, dphi_r))):
-                xk = lnX[k] + sign * _ONE_SIDED
-                sk = self._state(xk, self._u_at(xk))
-                dF[k] = sk.dlnF_dlna / sk.dlnh_dlna
-                da[k] = 1.0 / sk.dlnh_dlna
-                ph = sk.h1 / sk.h
-                dphi[k] = ph * (sk.dlnh1_dlna - sk.dlnh_dlna) / sk.dlnh_dlna
+        for side, (dF, da, dphi) in ((0, (dF_l, da_l, dphi_l)), (1, (dF_r, da_r, dphi_r))):
+            sk = _take(batch, slice(m + side * nk, m + (side + 1) * nk))
+            dF[k], da[k], dphi[k] = _log_slopes(sk)
+        phi = st.h1 / st.h
         s = np.log(st.h)
         ds = np.diff(s)
         if not np.all(ds > 0.0):
@@ -231,9 +277,7 @@ class ContactLaw:
 
     def _measure(self) -> dict:
         """Largest relative error at three probes inside every interval (× safety factor)."""
-        lnX = self._lnX_nodes
-        probes = np.concatenate([lnX[:-1] + f * np.diff(lnX) for f in (0.21, 0.5, 0.79)])
-        st = self._state(probes, self._u_at(probes))
+        st = self._probe_state  # exact states at the probes, solved by :meth:`_build`
         F, k, a, h1 = self._eval(st.h, full=True)
         rel = lambda x, y: float(np.max(np.abs(x / y - 1.0)))  # noqa: E731
         return {

@@ -6,8 +6,12 @@ Newton steps are accepted inside the current bracket; otherwise the bracket is
 closed by a false-position step with the Illinois modification (Dowell & Jarratt
 1971: the stored end value that is kept twice in a row is halved, which makes the
 step superlinear also where f has a kink, e.g. at a level boundary), or — while one
-side of the bracket is still unknown — expanded by doubling steps towards the root.
-Every evaluation tightens the bracket.
+side of the bracket is still unknown — expanded towards the root by the longer of a
+doubling step and the Newton step clipped to ``max_step``.
+Every evaluation tightens the bracket. An element has converged when its step is below
+``tol``; a Newton step below ``tol`` counts even where rounding puts it on a bracket end
+(f within rounding of 0), which would otherwise take an expansion or closing step away
+from the root.
 """
 
 from __future__ import annotations
@@ -77,7 +81,13 @@ def solve_increasing(
         ok &= np.abs(newton - xi) <= np.where(np.isfinite(l) & np.isfinite(h), np.inf, max_step)
         if it % 8 == 7:  # guard against slow Newton progress near kinks
             ok &= ~(np.isfinite(l) & np.isfinite(h))
+        # a Newton step below tol converges even where rounding puts it on a bracket end
+        ok |= np.isfinite(newton) & (dx > 0.0) & (np.abs(newton - xi) <= tol * np.maximum(1.0, np.abs(xi)))
         w = width[idx]
+        # expansion towards the root: the doubling width, or the rejected Newton step up to max_step
+        with np.errstate(invalid="ignore"):
+            reach = np.maximum(w, np.where(np.isfinite(newton) & (dx > 0.0),
+                                           np.minimum(np.abs(newton - xi), max_step), 0.0))
         expand_down = ~np.isfinite(l)
         expand_up = ~np.isfinite(h)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -85,7 +95,7 @@ def solve_increasing(
             regula = l - fl * (h - l) / (fh - fl)
             inside = np.isfinite(regula) & (regula > l) & (regula < h)
             closing = np.where(inside, regula, 0.5 * (l + h))
-        xn = np.where(ok, newton, np.where(expand_down, xi - w, np.where(expand_up, xi + w, closing)))
+        xn = np.where(ok, newton, np.where(expand_down, xi - reach, np.where(expand_up, xi + reach, closing)))
         width[idx] = np.where(~ok & (expand_down | expand_up), 2.0 * w, w)
         conv = done | (np.abs(xn - xi) <= tol * np.maximum(1.0, np.abs(xi)))
         x[idx] = np.where(done, xi, xn)

@@ -82,6 +82,9 @@ _DOMAIN_SLACK = 1.0 + 1e-9
 #: sections per pass and passes of the search for the domain end of a general pair
 _DOMAIN_SECTIONS = 64
 _DOMAIN_PASSES = 6
+#: largest change of u = ln(ρ_2/ρ_1) predicted from du/d ln a for the κ warm start of the
+#: inversion (the inner solve is bracketed anyway; this only keeps a long outer step sane)
+_PREDICT = 1.0
 
 
 def _num(x: float) -> str:
@@ -227,6 +230,13 @@ class UnifiedPair:
             u = np.zeros_like(a)
         elif u is None:
             u = self.solve_u(a)
+        return self._two_body_state(a, u)[0]
+
+    def _two_body_state(self, a, u):
+        """State of two deformable bodies at (a, u) and du/d ln a along the κ root
+        (implicit differentiation of g(u; a) = 0, module docstring)."""
+        Rs = self.R_star
+        R1, R2 = self.s1.radius, self.s2.radius
         w1, w2 = _sigmoid(u)
         k1, k2 = w1 / Rs, w2 / Rs
         r1 = self._body(self.law1, a, k1, R1)
@@ -264,12 +274,14 @@ class UnifiedPair:
         kappa = 1.0 / R1 - k1
         if self.mode == "equal":  # exact closed form, no rounding from 1/R1 − 1/(2R*)
             kappa = np.full_like(a, 0.5 * (1.0 / R1 - 1.0 / R2))
-        return UnifiedState(a, kappa, rho1, rho2, p, h1, h2, h, F, stiff,
-                            r1.Lambda, r2.Lambda, r1.piece + _PIECES * r2.piece, dlnF, dh / h, dlnh1)
+        st = UnifiedState(a, kappa, rho1, rho2, p, h1, h2, h, F, stiff,
+                          r1.Lambda, r2.Lambda, r1.piece + _PIECES * r2.piece, dlnF, dh / h, dlnh1)
+        return st, du
 
     # ------------------------------------------------------------------ inversion h → a
-    def _invert(self, h):
-        """Contact radius a (and the κ variable u, general mode) for approaches h > 0 (1-D)."""
+    def _invert(self, h, with_u: bool = True):
+        """Contact radius a (and the κ variable u, general mode and ``with_u``; else None) for
+        approaches h > 0 (1-D)."""
         h = np.asarray(h, dtype=float)
         lnh = np.log(h)
         t0 = 0.5 * (lnh + math.log(self.R_star))  # Hertz: a² = R* h
@@ -283,23 +295,27 @@ class UnifiedPair:
                 return np.log(s.h) - lnh[idx], s.dlnh_dlna
             return np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14, describe=describe)), None
 
-        u_warm = np.full(h.shape, self._u0)
+        # κ warm start: u at the last iterate t_w, continued to t along the root (du/d ln a)
+        t_w, u_w, du_w = t0.copy(), np.full(h.shape, self._u0), np.zeros(h.shape)
+
+        def guess(t, idx):
+            return u_w[idx] + np.clip(du_w[idx] * (t - t_w[idx]), -_PREDICT, _PREDICT)
 
         def f(t, idx):
             a = np.exp(t)
-            u = self.solve_u(a, u_warm[idx])
-            u_warm[idx] = u
-            s = self.state_at_a(a, u)
+            u = self.solve_u(a, guess(t, idx))
+            s, du = self._two_body_state(a, u)
+            t_w[idx], u_w[idx], du_w[idx] = t, u, du
             return np.log(s.h) - lnh[idx], s.dlnh_dlna
 
-        a = np.exp(solve_increasing(f, t0, step=0.5, tol=1e-14, describe=describe))
-        return a, self.solve_u(a, u_warm)
+        t = solve_increasing(f, t0, step=0.5, tol=1e-14, describe=describe)
+        return np.exp(t), (self.solve_u(np.exp(t), guess(t, slice(None))) if with_u else None)
 
     def a_from_h(self, h) -> np.ndarray:
         """Contact radius for approaches h (1-D, 0 < h ≤ ``domain.h_max``): monotone root of
         h(a) = h in ln a."""
         self.check_approach(h)
-        return self._invert(h)[0]
+        return self._invert(h, with_u=False)[0]
 
     def state_from_h(self, h) -> UnifiedState:
         """Full state for approaches h (1-D, 0 < h ≤ ``domain.h_max``): inversion then

@@ -8,10 +8,11 @@ import time
 import numpy as np
 import pytest
 
-from spherecontact.model import Material, Sphere, contact
+from spherecontact.model import Material, Sphere, contact, fast
 from spherecontact.model.cli import curve, register
 from spherecontact.model.coefficients import LITERATURE, Coefficients, default_coefficients
 from spherecontact.model.fast import ContactLaw, contact_table
+from spherecontact.model.single import BodyLaw
 
 CO = Coefficients.from_dict(LITERATURE)
 STEEL = Material(E=210e9, nu=0.3, sigma_y=400e6, K=600e6, n=0.3)
@@ -114,3 +115,75 @@ def test_cli_bad_input_is_value_error():
         args.func(args)
     with pytest.raises(ValueError, match="h-max"):
         curve(Sphere(R, STEEL), Sphere(R, STEEL), -1.0)
+
+
+STRONG = (Sphere(R, Material(E=200e9, nu=0.3, sigma_y=1500e6, K=500e6, n=0.2)),
+          Sphere(3 * R, Material(E=70e9, nu=0.33, sigma_y=60e6, K=150e6, n=0.4)))
+BATCH_PAIRS = {**PAIRS, "rigid_flat": (Sphere(R, STEEL), Sphere(math.inf, Material.rigid())),
+               "strong": STRONG}
+
+
+@pytest.mark.parametrize("name", ["equal", "rigid_flat", "dissimilar", "table", "strong"])
+def test_batched_table_states_equal_scalar_solves(name):
+    """The build solves nodes, the one-sided points at kinks and the error probes in one
+    vectorised κ solve (warm-started from the regular grid): each state equals the exact
+    state of that contact radius solved alone from the Hertz start, to 1e-12."""
+    law = ContactLaw(*BATCH_PAIRS[name], coeffs=CO)
+    p = law.pair
+    st = law._node_state
+    k = np.nonzero(np.isin(law._lnX_nodes, np.log(law.pair.state_from_h(law.kinks).a / p.R_star)))[0]
+    nodes = np.unique(np.concatenate([np.arange(0, st.a.size, 37), [st.a.size - 1], k]))
+    probes = np.arange(0, law._probe_state.a.size, 101)
+    for batch, sel in ((st, nodes), (law._probe_state, probes)):
+        for i in sel:
+            one = p.state_at_a(batch.a[i:i + 1])
+            for f in ("F", "h", "h1", "stiffness", "dlnh1_dlna"):
+                x, y = getattr(batch, f)[i], getattr(one, f)[0]
+                assert abs(x - y) <= 1e-12 * max(abs(y), 1e-300), (f, i, x, y)
+            assert batch.piece[i] == one.piece[0]
+
+
+@pytest.mark.parametrize("name", ["dissimilar", "table"])
+def test_kinks_are_located_to_the_tolerance(name):
+    """Every kink is the first radius of its new piece: the piece changes within _KINK_TOL
+    (ln a) below it."""
+    law = ContactLaw(*BATCH_PAIRS[name], coeffs=CO)
+    p = law.pair
+    lnX = law._lnX_nodes[np.isin(np.exp(law._s), law.kinks)]
+    assert lnX.size == law.kinks.size > 0
+    at = p.state_at_a(p.R_star * np.exp(lnX)).piece
+    below = p.state_at_a(p.R_star * np.exp(lnX - 2.0 * fast._KINK_TOL)).piece
+    assert np.all(at != below)
+
+
+@pytest.mark.parametrize("width", [0.02, 0.01, 0.005, 1e-6])
+@pytest.mark.parametrize("kinks", [1, 3, 6, 20, 200])
+def test_kink_search_sections(width, kinks):
+    """Sections per pass: brackets of ``width`` shrink below _KINK_TOL in the fewest passes
+    the point budget allows (16 sections per kink at least), and no more sections than that
+    number of passes needs (plus the 1 % margin against rounding)."""
+    n = fast._sections(width, kinks)
+    ratio = width / fast._KINK_TOL
+    passes = math.ceil(math.log(ratio) / math.log(n))
+    assert n ** passes >= ratio
+    assert (n - 1) * kinks <= max(fast._KINK_POINTS, 16 * kinks)
+    most = max(fast._KINK_POINTS // kinks, 16)
+    assert passes == math.ceil(math.log(ratio) / math.log(most))
+    assert n <= 1.01 * ratio ** (1.0 / passes) + 1.0
+
+
+@pytest.mark.parametrize(("name", "most"), [("dissimilar", 110), ("table", 150), ("equal", 30)])
+def test_setup_cost_in_body_responses(monkeypatch, name, most):
+    """The setup cost is the number of body-response evaluations (each one vectorised over all
+    active points; its fixed cost dominates): 90, 124 and 16 with this coefficient set (178,
+    376 and 114 before the κ solves were batched and warm-started)."""
+    calls = [0]
+    response = BodyLaw.response
+
+    def counted(self, *args, **kw):
+        calls[0] += 1
+        return response(self, *args, **kw)
+    ContactLaw(*BATCH_PAIRS[name], coeffs=CO)  # the pair's domain is cached: not counted
+    monkeypatch.setattr(BodyLaw, "response", counted)
+    ContactLaw(*BATCH_PAIRS[name], coeffs=CO)
+    assert 0 < calls[0] <= most

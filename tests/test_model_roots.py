@@ -58,3 +58,40 @@ def test_table_of_a_dissimilar_pair_needs_few_kappa_iterations(monkeypatch):
         ContactLaw(Sphere(1e-3, steel), Sphere(2e-3, alu))
     evaluations = max(n for size, n in counts if size > 500)
     assert 3 <= evaluations <= 15
+
+
+def _counting(f):
+    """f wrapped to count its calls (one call evaluates all active elements)."""
+    calls = [0]
+
+    def g(x, idx):
+        calls[0] += 1
+        return f(x, idx)
+    return g, calls
+
+
+def test_newton_step_below_tol_on_a_bracket_end_converges():
+    """An inversion-like equation, ln h(t) − ln h* with ln h ≈ 2t + 7.3 ≈ −30: rounding of
+    ln h is about an ulp of t, so once Newton has landed on the root the next Newton step can
+    round to t itself, a bracket end. It converges there (it used to be rejected, reopening
+    the bracket: 44 calls instead of 2, and residuals up to 3e-13)."""
+    rng = np.random.default_rng(3)
+    target = rng.uniform(-32.0, -28.0, 400)
+
+    def lnh(x, idx):
+        e = 1e-8 * np.exp(x)
+        return 2.0 * x + np.log1p(e) + 7.3 - target[idx], 2.0 + e / (1.0 + e)
+    f, calls = _counting(lnh)
+    x = solve_increasing(f, 0.5 * (target - 7.3) + 0.3, step=0.5, tol=1e-14)
+    assert np.abs(lnh(x, np.arange(target.size))[0]).max() <= 1e-14
+    assert calls[0] <= 3
+
+
+def test_far_root_is_approached_by_clipped_newton_steps():
+    """While the bracket is open the Newton step, clipped to max_step, sets the expansion
+    when it is longer than the doubling step (1, 2, 4, ... from ``step``)."""
+    roots = np.array([5.0, 7.5, 11.0])
+    f, calls = _counting(lambda x, idx: (x - roots[idx], np.ones_like(x)))
+    x = solve_increasing(f, np.zeros(3), step=1.0, max_step=4.0, tol=1e-14)
+    assert np.array_equal(x, roots)
+    assert calls[0] <= 4  # doubling steps alone: 0, 1, 3, 7, then Newton (5 calls)

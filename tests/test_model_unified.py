@@ -198,3 +198,34 @@ def test_forward_from_radius_matches_inversion():
     assert np.allclose(fw.kappa, st.kappa, rtol=1e-8)
     with pytest.raises(ValueError, match="contact radius"):
         contact_from_radius(s1, s2, [0.0, 1e-5], CO)
+
+
+STRONG = (Sphere(R, Material(E=200e9, nu=0.3, sigma_y=1500e6, K=500e6, n=0.2)),
+          Sphere(3 * R, Material(E=70e9, nu=0.33, sigma_y=60e6, K=150e6, n=0.4)))
+
+
+@pytest.mark.parametrize("name", ["dissimilar", "dissimilar_table", "strong"])
+def test_two_body_state_slope_of_the_kappa_root(name):
+    """du/d ln a returned with the state (the κ warm start of the inversion) is the slope of
+    the solved root u(ln a), and the state is the one of ``state_at_a``."""
+    p = UnifiedPair(*(STRONG if name == "strong" else PAIRS[name]), CO)
+    a = p.R_star * np.geomspace(1e-4, 0.5, 9)
+    u = p.solve_u(a)
+    st, du = p._two_body_state(a, u)
+    assert all(np.array_equal(x, y) for x, y in zip(st, p.state_at_a(a, u), strict=True))
+    d = 1e-6
+    fd = (p.solve_u(a * math.exp(d)) - p.solve_u(a * math.exp(-d))) / (2 * d)
+    assert np.allclose(du, fd, rtol=1e-6, atol=1e-8)
+    assert np.max(np.abs(du)) > 0.1  # the root moves: the check is not trivially 0 = 0
+
+
+@pytest.mark.parametrize("name", ["equal", "rigid_flat", "dissimilar", "dissimilar_table", "strong"])
+def test_inversion_of_many_approaches_equals_one_at_a_time(name):
+    """The vectorised inversion h → a (κ warm-started along the root inside it) gives every
+    element the radius of a scalar inversion of that element alone, and h(a) = h."""
+    p = UnifiedPair(*(STRONG if name == "strong" else PAIRS[name]), CO)
+    h = np.geomspace(1e-10 * p.R_star, 0.5 * min(p.domain.h_max, p.R_star), 23)
+    a, _ = p._invert(h)
+    one = np.array([p._invert(h[i:i + 1])[0][0] for i in range(h.size)])
+    assert np.max(np.abs(a / one - 1.0)) <= 1e-12
+    assert np.max(np.abs(p.state_at_a(a).h / h - 1.0)) <= 1e-13
