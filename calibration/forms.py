@@ -385,6 +385,16 @@ FORMS: dict[str, Form] = {
                                "hardening exponent", smooth=True, n_shape_H=2, n_shape_c=2,
                                n_finite_H=2, n_finite_c=2, finite_by_level=True, n_collapse_nH=2,
                                n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True),
+    "smooth2_fs2_xn2n_x2_g": Form("smooth2_fs2_xn2n_x2_g", "as smooth2_fs2_xn2n_g, both collapse "
+                                  "limits quadratic in a/R", smooth=True, n_shape_H=2, n_shape_c=2,
+                                  n_finite_H=2, n_finite_c=2, finite_by_level=True, n_collapse_H=2,
+                                  n_collapse_c=2, n_collapse_nH=2, n_collapse_xnH=2,
+                                  n_collapse_xnc=2, strain_growth=True),
+    "smooth2_fs2_xn2n_x3_g": Form("smooth2_fs2_xn2n_x3_g", "as smooth2_fs2_xn2n_g, both collapse "
+                                  "limits cubic in a/R", smooth=True, n_shape_H=2, n_shape_c=2,
+                                  n_finite_H=2, n_finite_c=2, finite_by_level=True, n_collapse_H=3,
+                                  n_collapse_c=3, n_collapse_nH=2, n_collapse_xnH=2,
+                                  n_collapse_xnc=2, strain_growth=True),
     # the two parts of the xnw weight alone (``--forms``)
     "smooth2_fs2_xnk": Form("smooth2_fs2_xnk", "as smooth2_fs2_xn, c² collapse weight with its own "
                             "sharpness", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
@@ -395,9 +405,9 @@ FORMS: dict[str, Form] = {
                             n_finite_c=2, finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
                             c2_offset=True),
 }
-#: forms compared by cross-validation in every calibration: the seed's, and the steps that each
-#: lowered the held-out error on campaign v2 (calibration/README.md; the forms they beat there,
-#: poly, smooth, smooth2, smooth2_fs, smooth2_ld3, smooth2_fs2_xn and _xnw, stay in FORMS for
-#: ``--forms``: cross-validating all 13 took 100 of the 128 s of a calibration)
-CANDIDATES = ("seed", "smooth2_fs2", "smooth2_fs2_g", "smooth2_fs2_xn_g", "smooth2_fs2_xn2_g",
-              "smooth2_fs2_xn2n_g")
+#: forms compared by cross-validation in every calibration: the seed's, the form chosen on
+#: campaign v2 before the collapse limits were made quadratic in a/R, and the quadratic and cubic
+#: collapse limits (calibration/README.md). The steps that led to smooth2_fs2_xn2n_g (smooth2_fs2,
+#: _g, _xn_g, _xn2_g) and the forms they beat stay in FORMS for ``--forms``: cross-validating
+#: every form costs a minute per four forms.
+CANDIDATES = ("seed", "smooth2_fs2_xn2n_g", "smooth2_fs2_xn2n_x2_g", "smooth2_fs2_xn2n_x3_g")

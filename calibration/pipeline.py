@@ -35,6 +35,7 @@ from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
+from .interface import InterfaceFit, fit_interface, load_pairs
 from .threads import single_threaded_blas
 from .workers import DEFAULT_WORKERS, Workers
 
@@ -64,6 +65,9 @@ REFERENCES = {
     "level_II": "Fitted shape; seed sec. 2 (straight in ln Lambda) compared by cross-validation.",
     "finite_size": "Fitted: finite sphere (far field cut off at ~R) and large deformation, "
                    "vanishing as a/R -> 0 (DESIGN sec. 2).",
+    "interface": "Fitted on the two-body calibration runs (calibration/interface.py): the split "
+                 "of two plastic bodies of near-equal hardness stays at the Hertz partition while "
+                 "the plastic zones are contained and moves to equal strains as the contact deepens.",
     "collapse": "Fitted: at large a/R the plastic zone reaches the free surface and the sphere "
                 "flattens as a whole; smooth minimum of the half-space and whole-body hardness "
                 "(model/README.md).",
@@ -94,6 +98,7 @@ class Calibration:
     noise: dict = field(default_factory=dict)      # scatter of the FE points (diagnostics.noise_floor)
     breakdown: dict = field(default_factory=dict)  # residuals of the chosen form by band
     regimes: list[RegimeFold] = field(default_factory=list)  # chosen form, one regime held out
+    interface: InterfaceFit | None = None  # two-body interface terms (``interface.py``)
 
     @property
     def best(self) -> FitResult:
@@ -121,10 +126,11 @@ def _warm_start(form: Form, base: FitResult) -> np.ndarray:
 
 def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
                    large_deformation_options: bool = True, source: dict | None = None,
-                   workers: int = DEFAULT_WORKERS) -> Calibration:
+                   workers: int = DEFAULT_WORKERS, pairs=()) -> Calibration:
     """Fit, cross-validate, choose, check. ``runs``: iterable of ``(key, run)``; the
     independent fits run on ``workers`` processes, with one BLAS thread each whatever the
-    environment says (the result depends on neither)."""
+    environment says (the result depends on neither). ``pairs``: two-body runs
+    (``interface.PairCurve``) for the interface terms of the chosen form (none: left out)."""
     t0 = time.perf_counter()
     with single_threaded_blas():  # the result must not depend on the BLAS thread count (threads.py)
         ds = build_dataset(runs)
@@ -132,6 +138,10 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
         with Workers(ds, workers) as pool:
             cal = _calibrate(ds, pool, candidates, cross_validation, large_deformation_options, timings)
     cal.source = dict(source or {})
+    if pairs:
+        t = time.perf_counter()
+        cal.interface = fit_interface(list(pairs), cal.best.coeffs)
+        timings["interface_s"] = time.perf_counter() - t
     timings["total_s"] = time.perf_counter() - t0
     return cal
 
@@ -242,8 +252,8 @@ def load_runs(db_path, include_stopped: bool = True):
                          f"{len(db)} entries in all)")
     used = {r.key for r, _ in pairs}
     left_out = [{"key": r.key, "case": r.case, "status": r.status,
-                 "reason": ("two bodies (single-body fit)" if r.inputs.get("scene") == "two_body"
-                            else r.reason)}
+                 "reason": ("two bodies: interface terms only (calibration/interface.py)"
+                            if r.inputs.get("scene") == "two_body" else r.reason)}
                 for r in db.records(set="calibration") if r.key not in used]
     dates = sorted(str(run.provenance.get("date_utc", "")) for _, run in pairs)
     partial = [{"key": r.key, "case": r.case, "h_last": float(run.h.max()), "reason": r.reason}
@@ -373,6 +383,15 @@ def coefficient_file(cal: Calibration) -> dict:
         "notes": "Residuals are relative (model/FE - 1) over the calibration points; "
                  "see reports/calibration/index.md.",
     }
+    if cal.interface is not None:
+        f = cal.interface
+        if f.coupling > 0.0:
+            d["interface"] = {k: round_sig(v) for k, v in f.section().items()}
+        d["provenance"]["interface_fit"] = {
+            "method": "grid search of the anchor radius and exponent on the two-body calibration "
+                      "runs, largest |h1/h model - FE| (calibration/interface.py)",
+            "pairs": {name: {"split_max": _stat(e), "split_max_without": _stat(f.errors_none[name])}
+                      for name, e in f.errors.items()}}
     d["references"] = dict(REFERENCES)
     Coefficients.from_dict(d)  # validate before writing
     return d
@@ -394,8 +413,10 @@ def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
     """Calibrate from the database at ``db_path``; write the coefficient file and the report."""
     t0 = time.perf_counter()
     runs, source = load_runs(db_path, include_stopped)
+    pairs = load_pairs(db_path)
+    source["pairs"] = [c.name for c in pairs]
     read_s = time.perf_counter() - t0
-    cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers)
+    cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs)
     cal.timings["read_s"] = read_s
     if out is not None:
         write_json(out, coefficient_file(cal))

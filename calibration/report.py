@@ -311,6 +311,20 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
                      f"{'yes' if ok else 'NO'} |")
         L.append("")
 
+    if cal.interface is not None:
+        f = cal.interface
+        L.append("## Two-body interface terms (`calibration/interface.py`)\n")
+        state = (f"coupling λ = {f.coupling:g}, similarity δ = {f.similarity:g}, anchor radius "
+                 f"a_c = {f.radius:g} R*, exponent k = {f.exponent:g}" if f.coupling > 0 else
+                 "left out: no grid point lowered the largest split error")
+        L.append(f"Interface equation ln p₁ − ln p₂ + C(a)(u − u_A(a)) = 0 (`model/unified.py`); "
+                 f"{state}. Largest |h₁/h model − FE| per two-body calibration run, in percentage "
+                 f"points of h (a ≥ 0.01 R, h/R ≤ 0.3):\n")
+        L.append("| pair | equal pressures alone | with the interface terms |")
+        L.append("|---|---|---|")
+        for name, e in f.errors.items():
+            L.append(f"| {name} | {100 * f.errors_none[name]:.1f} | {100 * e:.1f} |")
+        L.append("")
     L.append("## Fitted coefficients\n")
     L.append("| key | value |")
     L.append("|---|---|")

@@ -147,7 +147,26 @@ LITERATURE: dict = {
 
 
 #: top-level keys a set may leave out (``to_dict`` writes them only when they are not the default)
-_OPTIONAL_TOP_KEYS = ("beta_growth",)
+_OPTIONAL_TOP_KEYS = ("beta_growth", "interface")
+
+
+#: allowed ranges of the ``interface`` section's numbers
+_INTERFACE_RANGES = {"coupling": (0.0, 1000.0), "similarity": (0.01, 10.0), "radius": (0.01, 100.0),
+                     "exponent": (0.5, 20.0)}
+
+
+def _interface(d: dict) -> dict:
+    """The optional ``interface`` section as ``Coefficients`` fields (absent: no coupling)."""
+    if "interface" not in d:
+        return {}
+    sec = _section(d, "interface")
+    out = {}
+    for key, (lo, hi) in _INTERFACE_RANGES.items():
+        v = _number(sec, key, "interface.")
+        if not lo <= v <= hi:
+            raise ValueError(f"coefficients: 'interface.{key}' must lie in [{lo:g}, {hi:g}], got {v!r}")
+        out[f"interface_{key}"] = v
+    return out
 
 
 def _number(d: dict, key: str, where: str) -> float:
@@ -345,6 +364,13 @@ class Coefficients:
     collapse_offset_c2: float | None = None     # None: 0
     level_II_smooth: bool = False
     beta_growth: float = 0.0  # γ of ε_rep = β x (1 + γ x); 0: the linear ε_rep = β x
+    #: two-body interface equation (``unified.py``): coupling λ (0: equal mean pressures alone),
+    #: similarity width δ of the fully plastic pressures, and the contact radius a_c/R* and
+    #: exponent k of the anchor's move from the Hertz partition to equal strains
+    interface_coupling: float = 0.0
+    interface_similarity: float = 0.2
+    interface_radius: float = 1.0
+    interface_exponent: float = 4.0
     source: str = "literature"
     schema_version: int = SCHEMA_VERSION
     provenance: dict = field(default_factory=dict, compare=False, hash=False, repr=False)
@@ -374,6 +400,7 @@ class Coefficients:
         growth = _number(d, "beta_growth", "") if "beta_growth" in d else 0.0
         if not 0.0 <= growth <= 100.0:
             raise ValueError(f"coefficients: 'beta_growth' must lie in [0, 100], got {growth!r}")
+        interface = _interface(d)
         lam1 = _number(d, "Lambda_I", "")
         lam3 = _number(d, "Lambda_III", "")
         if not 0.0 < lam1 < lam3:
@@ -472,6 +499,7 @@ class Coefficients:
             collapse_offset_c2=sc,
             level_II_smooth=smooth,
             beta_growth=growth,
+            **interface,
             source=source,
             schema_version=version,
             provenance=copy.deepcopy(provenance),
@@ -486,6 +514,11 @@ class Coefficients:
             "provenance": copy.deepcopy(self.provenance),
             "beta": self.beta,
             **({"beta_growth": self.beta_growth} if self.beta_growth else {}),
+            **({"interface": {"coupling": self.interface_coupling,
+                              "similarity": self.interface_similarity,
+                              "radius": self.interface_radius,
+                              "exponent": self.interface_exponent}}
+               if self.interface_coupling else {}),
             "Lambda_I": self.Lambda_I,
             "Lambda_III": self.Lambda_III,
             "H_bar_III": {"prefactor": self.H_bar_III_prefactor,

@@ -181,6 +181,22 @@ class BodyLaw:
     def E_prime(self) -> float:
         return self.material.E_prime
 
+    def plastic_state_at(self, x) -> tuple[np.ndarray, ...]:
+        """At x = a/ρ (vectorised): the level weight s(Λ) = 3t² − 2t³ (0 in Level I, 1 in
+        Level III; ``levels.level_weight``), ds/d ln x = (ds/d ln Λ)(1 − m), the fully plastic
+        pressure P = H̄_III σ_rep and d ln P/d ln x = m (m = d ln σ_rep/d ln x). An elastic
+        body: s = 0 and P = inf."""
+        mat, co = self.material, self.coeffs
+        x = np.asarray(x, dtype=float)
+        if math.isinf(mat.sigma_y):
+            zero = np.zeros_like(x)
+            return zero, zero, np.full_like(x, math.inf), zero
+        eps, g = representative_strain(x, co.beta, co.beta_growth)
+        sig = mat.flow_stress(eps)
+        m = flow_log_slope(mat, eps) * g
+        s, ds = level_weight(mat.E_prime * x / sig, co)
+        return s, ds * (1.0 - m), self.H_bar_III * sig, m
+
     def response(self, x, y=None, z: float = 0.0) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
         ``z`` the curvature ratio of the collapse limits (a constant of the pair,

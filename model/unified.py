@@ -11,6 +11,29 @@ For a given contact radius a, κ follows from equal mean pressures
 and h_i = a²/(2 c_i² ρ_i), h = h_1 + h_2, F = π a² p_m. The κ root is found in the
 variable u = ln(ρ_2/ρ_1) (ρ_1/R* = 1 + e^(−u)), where g(u) = ln p_1 − ln p_2 increases
 monotonically; in Level I the root is u = ln(E'_2/E'_1) (ρ_i = E'_i R*/E*, Hertz).
+
+Interface coupling (``Coefficients.interface_coupling`` λ, calibrated on the two-body runs):
+once both bodies are plastic, p_m depends on ρ_i only through H̄(Λ_i), which flattens as
+Λ_i → Λ_III, so near-equal hardness leaves the equal-pressure condition ill-conditioned and
+the split runs away (two EPP spheres of equal σ_Y and E ratio 3: h_1/h 0.99 at h/R = 0.3,
+the FE 0.55). The interface equation is therefore
+
+    g(u) = ln p_1 − ln p_2 + C(a) (u − u_A(a)) = 0,
+    C = λ f_E s_1 s_2 exp(−(ln(P_1/P_2)/δ)²),   u_A = u_H/(1 + (a/(a_c R*))^k),
+    f_E = u_H²/(u_H² + ε²),  u_H = ln(E'_2/E'_1),  ε = 0.1,
+
+with s_i the level weights (0 in Level I, 1 in Level III) and P_i = H̄_III σ_rep,i the fully
+plastic pressures of both bodies at the Hertz partition x_i = a/ρ_i,H. The coupling acts only
+where both bodies are plastic and their fully plastic pressures are within about δ of each
+other (the ill-conditioned case), and only where their moduli differ (f_E: the run-away is
+driven by the E-dependence of H̄(Λ) in Level II; equal materials of unequal radii keep the
+equal-pressure split, which the FE supports); it holds the split at the elastic partition
+u_H while the plastic zones are contained, as the FE does, and moves it to equal strains
+x_1 = x_2 (u = 0) as the contact deepens (a ≈ a_c R*). C and u_A do not depend on
+u, so g still rises with u and the root is unique; C = 0 while either body is elastic or in
+Level I (the Hertz split stays exact), and equal materials (u_H = 0) are left alone. The
+contact pressure is then √(p_1 p_2) (p_1 = p_2 for λ = 0).
+
 Scenes that need no κ solve: equal materials (with the finite-size ratio a/ρ or equal
 radii: ρ_1 = ρ_2 = 2R*) and a rigid partner (ρ = R* for the deformable body).
 
@@ -85,6 +108,11 @@ _DOMAIN_PASSES = 6
 #: largest change of u = ln(ρ_2/ρ_1) predicted from du/d ln a for the κ warm start of the
 #: inversion (the inner solve is bracketed anyway; this only keeps a long outer step sane)
 _PREDICT = 1.0
+#: ε of the interface coupling's modulus factor u_H²/(u_H² + ε²), u_H = ln(E'_2/E'_1): the coupling
+#: corrects the split's run-away driven by unequal moduli; equal moduli (u_H = 0) keep λ = 0's
+#: equation (equal materials of unequal radii: FE splits of radius ratio 2 and 4 within 9.2 and
+#: 6.4 percentage points without it, 33 with the coupling at full strength)
+_MODULUS_RATIO = 0.1
 
 
 def _num(x: float) -> str:
@@ -159,6 +187,8 @@ class UnifiedPair:
             self.mode = "general"
         if self.mode == "general":
             self._u0 = math.log(s2.material.E_prime / s1.material.E_prime)
+            # Hertz partition ρ_i,H = E'_i R*/E* (Level I root), where the coupling's weights are taken
+            self._rho_hertz = tuple(s_.material.E_prime * self.R_star / self.E_star for s_ in (s1, s2))
         # curvature ratios z_i = R_i/ρ_i,H − 1 of the collapse limits, ρ_i,H = E'_i R*/E*
         # (Hertz partition; constants of the pair, so the κ root stays unique)
         self._z = {}
@@ -181,8 +211,31 @@ class UnifiedPair:
         r2 = self._body(self.law2, a, w2 / self.R_star, self.s2.radius)
         A1 = r1.dlnp_dlnx + (r1.dlnp_dlny if self._ratio_rho else 0.0)
         A2 = r2.dlnp_dlnx + (r2.dlnp_dlny if self._ratio_rho else 0.0)
-        g = np.log(r1.p_m) - np.log(r2.p_m)
-        return g, A1 * w2 + A2 * w1, r1, r2
+        C, _, uA, _ = self._coupling(a)
+        g = np.log(r1.p_m) - np.log(r2.p_m) + C * (u - uA)
+        return g, A1 * w2 + A2 * w1 + C, r1, r2
+
+    def _coupling(self, a):
+        """C(a) = λ s_1 s_2 e^(−(ln(P_1/P_2)/δ)²) of the interface equation, the anchor
+        u_A(a) = u_H/(1 + (a/(a_c R*))^k) and their derivatives in ln a (module docstring), from
+        both bodies at the Hertz partition x_i = a/ρ_i,H. λ = 0: (0, 0, 0, 0)."""
+        co = self.coeffs
+        lam = co.interface_coupling
+        if not lam or self.mode != "general":
+            return 0.0, 0.0, 0.0, 0.0
+        s1, d1, P1, m1 = self.law1.plastic_state_at(a / self._rho_hertz[0])
+        s2, d2, P2, m2 = self.law2.plastic_state_at(a / self._rho_hertz[1])
+        delta = co.interface_similarity
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            q = np.where(np.isfinite(P1) & np.isfinite(P2), np.log(P1 / P2) / delta, np.inf)
+            e = np.exp(-q * q)
+            de = np.where(e > 0.0, -2.0 * q * e * (m1 - m2) / delta, 0.0)
+            t = (a / (co.interface_radius * self.R_star)) ** co.interface_exponent
+        phi = t / (1.0 + t)
+        lam = lam * self._u0**2 / (self._u0**2 + _MODULUS_RATIO**2)  # E-driven only
+        C = lam * s1 * s2 * e
+        dC = lam * ((d1 * s2 + s1 * d2) * e + s1 * s2 * de)
+        return C, dC, self._u0 * (1.0 - phi), -self._u0 * co.interface_exponent * phi * (1.0 - phi)
 
     def describe(self) -> str:
         """Both spheres (radius, material), for error messages."""
@@ -254,13 +307,15 @@ class UnifiedPair:
         if self.mode == "equal":
             du = np.zeros_like(a)
         else:
-            den = A1 * w2 + A2 * w1
+            C, dC, uA, duA = self._coupling(a)
+            den = A1 * w2 + A2 * w1 + C
             with np.errstate(divide="ignore", invalid="ignore"):
-                du = np.where(den > 0.0, -(B1 - B2) / den, 0.0)
+                du = np.where(den > 0.0, -(B1 - B2 + dC * (u - uA) - C * duA) / den, 0.0)
         dlnk1 = w2 * du
         dlnk2 = -w1 * du
-        p = r1.p_m
-        dlnp = B1 + A1 * dlnk1
+        # p_1 = p_2 (λ = 0); with the coupling term the contact pressure is their geometric mean
+        p = np.sqrt(r1.p_m * r2.p_m)
+        dlnp = 0.5 * (B1 + A1 * dlnk1 + B2 + A2 * dlnk2)
         h1 = a * a * k1 / (2.0 * r1.c2)
         h2 = a * a * k2 / (2.0 * r2.c2)
         dlnh1 = 2.0 + (1.0 - Ca1) * dlnk1 - Cb1

@@ -1,0 +1,111 @@
+"""Two-body interface terms (model/unified.py, calibration/interface.py): the split of two
+plastic bodies of near-equal hardness, exactness where they must not act, derivatives, fit."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from spherecontact.calibration.interface import EXPONENTS, RADII, PairCurve, fit_interface
+from spherecontact.model import ContactLaw, Material, Sphere, contact, load_coefficients
+from spherecontact.model.coefficients import Coefficients
+
+BASE = load_coefficients()
+CO = dataclasses.replace(BASE, interface_coupling=10.0, interface_similarity=0.1,
+                         interface_radius=0.8, interface_exponent=6.0)
+SOFT, STIFF = Material(E=300.0, nu=0.3, sigma_y=1.0), Material(E=900.0, nu=0.3, sigma_y=1.0)
+H = np.geomspace(1e-4, 0.3, 60)
+
+
+def _split(s1, s2, co, h=H):
+    st = contact(s1, s2, h, co)
+    return st.h1 / h, st
+
+
+def test_equal_yield_split_no_longer_runs_away():
+    # EPP E/σY 300 against 900 (FE: 0.75 elastic, 0.55 at h/R = 0.3): equal pressures alone put
+    # nearly all of the approach into the softer sphere; the interface terms keep it near the FE
+    s1, s2 = Sphere(1.0, SOFT), Sphere(1.0, STIFF)
+    without, _ = _split(s1, s2, dataclasses.replace(CO, interface_coupling=0.0))
+    with_, _ = _split(s1, s2, CO)
+    assert without[-1] > 0.95
+    assert 0.5 < with_[-1] < 0.65
+    assert np.all(np.abs(with_[H < 0.003] - 0.75) < 0.02)  # the elastic partition while contained
+
+
+@pytest.mark.parametrize("pair", ["elastic", "equal_material_radii_2", "yield_ratio_1.5",
+                                  "equal_E_yield_ratio_1.02"])
+def test_interface_terms_leave_other_pairs_alone(pair):
+    s1, s2 = {
+        "elastic": (Sphere(1.0, Material(E=1.0, nu=0.3)), Sphere(2.0, Material(E=3.0, nu=0.25))),
+        "equal_material_radii_2": (Sphere(1.0, SOFT), Sphere(2.0, SOFT)),
+        "yield_ratio_1.5": (Sphere(1.0, SOFT), Sphere(1.0, Material(E=900.0, nu=0.3, sigma_y=1.5))),
+        # equal moduli: no modulus-driven run-away to correct (radius ratio 2 and 4 of the FE
+        # follow the equal-pressure split within 9 and 6 percentage points)
+        "equal_E_yield_ratio_1.02": (Sphere(1.0, SOFT), Sphere(0.5, Material(E=300.0, nu=0.3, sigma_y=1.02))),
+    }[pair]
+    a, _ = _split(s1, s2, dataclasses.replace(CO, interface_coupling=0.0))
+    b, _ = _split(s1, s2, CO)
+    np.testing.assert_allclose(b, a, atol=1e-9)
+    if pair == "elastic":  # Hertz: h1/h = E2'/(E1' + E2') (finite-size terms: 0.2 % at h/R 1e-4)
+        e1, e2 = s1.material.E_prime, s2.material.E_prime
+        np.testing.assert_allclose(b[H < 1e-3], e2 / (e1 + e2), rtol=5e-3)
+
+
+def test_stiffness_and_slopes_are_exact_with_the_coupling():
+    s1, s2 = Sphere(1.0, SOFT), Sphere(1.5, STIFF)
+    h = np.geomspace(1e-3, 0.2, 25)
+    eps = 1e-6
+    mid = contact(s1, s2, h, CO)
+    plus, minus = contact(s1, s2, h * (1 + eps), CO), contact(s1, s2, h * (1 - eps), CO)
+    fd = (plus.F - minus.F) / (2 * eps * h)
+    np.testing.assert_allclose(mid.stiffness, fd, rtol=2e-4)
+
+
+@pytest.mark.parametrize("ratio", [1.02, 1.05, 1.1, 1.2, 1.3])
+def test_near_equal_hardness_stays_finite_and_monotone(ratio):
+    # the similarity factor's transition band (fully plastic pressures 2-30 % apart)
+    s1 = Sphere(1.0, SOFT)
+    s2 = Sphere(1.0, Material(E=900.0, nu=0.3, sigma_y=ratio, K=0.5, n=0.3))
+    split, st = _split(s1, s2, CO, np.geomspace(1e-5, 0.4, 300))
+    assert np.all(np.isfinite(st.F)) and np.all(np.diff(st.F) > 0) and np.all(np.diff(st.a) > 0)
+    assert np.all((split > 0.0) & (split < 1.0))
+
+
+def test_fast_path_tabulates_the_coupled_pair():
+    law = ContactLaw(Sphere(1.0, SOFT), Sphere(1.0, STIFF), coeffs=CO, h_max=0.3)
+    assert law.error["F"] < 1e-6
+    h = np.geomspace(1e-4, 0.3, 200)
+    F, k = law.force(h)
+    ex = contact(Sphere(1.0, SOFT), Sphere(1.0, STIFF), h, CO)
+    np.testing.assert_allclose(F, ex.F, rtol=1e-6)
+
+
+def test_coefficient_file_round_trip_and_bad_values():
+    d = CO.to_dict()
+    assert d["interface"] == {"coupling": 10.0, "similarity": 0.1, "radius": 0.8, "exponent": 6.0}
+    assert Coefficients.from_dict(d) == CO
+    assert "interface" not in BASE.replace().to_dict() or BASE.interface_coupling > 0
+    older = {k: v for k, v in d.items() if k != "interface"}
+    assert Coefficients.from_dict(older).interface_coupling == 0.0  # older files read
+    for key, bad in (("radius", 0.0), ("exponent", 50.0), ("coupling", -1.0), ("similarity", math.nan)):
+        dd = CO.to_dict()
+        dd["interface"][key] = bad
+        with pytest.raises(ValueError, match=f"interface.{key}"):
+            Coefficients.from_dict(dd)
+
+
+def test_grid_search_recovers_the_anchor_it_was_given():
+    # synthetic "FE" splits made by the model with a known anchor: the fit finds it again
+    truth = dataclasses.replace(CO, interface_radius=RADII[3], interface_exponent=EXPONENTS[1])
+    pairs = []
+    softer = Sphere(1.0, Material(E=99.9, nu=0.3, sigma_y=1.0))
+    for name, s2 in (("stiffer", Sphere(1.0, STIFF)), ("softer", softer)):
+        s1 = Sphere(1.0, SOFT)
+        h = np.geomspace(3e-3, 0.3, 30)
+        split, _ = _split(s1, s2, truth, h)
+        pairs.append(PairCurve(name, s1, s2, h, split))
+    f = fit_interface(pairs, dataclasses.replace(CO, interface_coupling=0.0))
+    assert (f.radius, f.exponent) == (RADII[3], EXPONENTS[1])
+    assert max(f.errors.values()) < 1e-9 < min(f.errors_none.values())
