@@ -21,7 +21,7 @@ import numpy as np
 from ..model.material import Material
 from .assembly import ELEMENTS
 from .io import SCENES, check_inputs, run_indentation, write_run
-from .mesh import DENSITY_RANGE
+from .mesh import DENSITY_RANGE, EDGE_BAND_MAX
 from .solver import PENALTY_SCALES, SolverOptions
 
 __all__ = ["register", "run_command", "render_command", "read_flow_table", "material_from_args",
@@ -171,7 +171,7 @@ def run_command(args: argparse.Namespace) -> int:
     checked = check_inputs(material, args.radius, args.h_max, args.indenter_radius,
                            args.mesh_density, args.element, options, radius2=radius2,
                            material2=material2, scene=args.scene.replace("-", "_"),
-                           unload_at=args.unload_at)
+                           unload_at=args.unload_at, edge_band=args.edge_band)
     print(f"scene: {checked['scene']} ({SCENES[checked['scene']]})", file=sys.stderr)
     bar = _Progress(args.h_max, args.quiet)
     try:
@@ -179,7 +179,8 @@ def run_command(args: argparse.Namespace) -> int:
                                  indenter_radius=args.indenter_radius, density=args.mesh_density,
                                  element=args.element, options=options, progress=bar,
                                  radius2=radius2, material2=material2,
-                                 scene=args.scene.replace("-", "_"), unload_at=args.unload_at)
+                                 scene=args.scene.replace("-", "_"), unload_at=args.unload_at,
+                                 edge_band=args.edge_band)
     finally:
         bar.close()
     extra = {"entry_point": "spherecontact fem run",
@@ -252,6 +253,10 @@ def _add_numerics(add) -> None:
     add(grp, "--mesh-density", type=float, default=1.0,
         help=f"mesh-density factor in [{lo:g}, {hi:g}]; element sizes scale as 1/density "
              "(default 1)")
+    add(grp, "--edge-band", type=float, default=0.0,
+        help=f"surface band where the contact edge travels: element size = edge-band x distance "
+             f"from the pole, in [0, {EDGE_BAND_MAX:g}] (default 0: the default mesh; the reference "
+             "campaigns use 0.03, FE scatter 0.7 %% instead of 2.6 %%)")
     add(grp, "--element", choices=sorted(ELEMENTS), default="q8r",
         help="q8r: 8-node quads, 2x2 reduced integration (default, no locking); "
              "q4: bilinear quads, full integration (locks; for comparison)")

@@ -38,6 +38,17 @@ def test_run_rigid_flat_end_to_end(tmp_path, capsys):
     assert f"{run.F[-1]:.6g}" in printed
 
 
+def test_edge_band_reaches_the_mesh(tmp_path):
+    # the reference campaigns' surface band (edge_band 0.03) is available from the command line
+    runs = {}
+    for band in ("0", "0.03"):
+        out = tmp_path / f"band{band}.h5"
+        assert fem_run(*EPP, "--h-max", "0.002", "--edge-band", band, "--out", str(out), *TINY) == 0
+        runs[band] = read_run(out)
+    assert runs["0.03"].inputs["edge_band"] == 0.03 and runs["0"].inputs.get("edge_band", 0.0) == 0.0
+    assert runs["0.03"].inputs["n_dofs"] > runs["0"].inputs["n_dofs"]
+
+
 def test_run_rigid_sphere_with_flow_table(tmp_path):
     table = tmp_path / "flow.csv"
     table.write_text("# copper-like curve\neps_p,sigma\n0,1\n0.05,1.5\n0.2,2.0\n")
@@ -85,6 +96,7 @@ BAD = {
     "dh": (["--E", "200", "--h-max", "0.1", "--dh-first", "0.5"], "dh_first"),
     "iterations": (["--E", "200", "--h-max", "0.1", "--max-iterations", "1"], "max_iterations"),
     "tol": (["--E", "200", "--h-max", "0.1", "--tol", "0"], "tol"),
+    "edge_band": (["--E", "200", "--h-max", "0.1", "--edge-band", "0.5"], "edge_band"),
 }
 
 
