@@ -86,7 +86,7 @@ def test_coefficient_file_round_trip_and_bad_values():
     d = CO.to_dict()
     assert d["interface"] == {"coupling": 10.0, "similarity": 0.1, "radius": 0.8, "exponent": 6.0}
     assert Coefficients.from_dict(d) == CO
-    assert "interface" not in BASE.replace().to_dict() or BASE.interface_coupling > 0
+    assert "interface" not in dataclasses.replace(CO, interface_coupling=0.0).to_dict()
     older = {k: v for k, v in d.items() if k != "interface"}
     assert Coefficients.from_dict(older).interface_coupling == 0.0  # older files read
     for key, bad in (("radius", 0.0), ("exponent", 50.0), ("coupling", -1.0), ("similarity", math.nan)):
@@ -109,3 +109,16 @@ def test_grid_search_recovers_the_anchor_it_was_given():
     f = fit_interface(pairs, dataclasses.replace(CO, interface_coupling=0.0))
     assert (f.radius, f.exponent) == (RADII[3], EXPONENTS[1])
     assert max(f.errors.values()) < 1e-9 < min(f.errors_none.values())
+
+
+def test_pairs_of_clearly_unequal_hardness_skip_the_coupling():
+    # steel against aluminium (fully plastic pressures ~4x apart): the factor is < e^-36 at every
+    # admissible contact radius, so the terms are not evaluated; equal yield stress: evaluated
+    from spherecontact.model.unified import UnifiedPair
+
+    steel = Material(E=210e9, nu=0.3, sigma_y=400e6, K=600e6, n=0.3)
+    alu = Material(E=70e9, nu=0.33, sigma_y=100e6, K=200e6, n=0.5)
+    assert not UnifiedPair(Sphere(1e-3, steel), Sphere(2e-3, alu), CO)._coupled
+    assert UnifiedPair(Sphere(1.0, SOFT), Sphere(1.0, STIFF), CO)._coupled
+    off = dataclasses.replace(CO, interface_coupling=0.0)
+    assert not UnifiedPair(Sphere(1.0, SOFT), Sphere(1.0, STIFF), off)._coupled
