@@ -31,6 +31,7 @@ off by 1–5 % below; points with a < ``A_MIN_ELEMENTS`` pole elements are dropp
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -194,6 +195,9 @@ class Dataset:
     h_R: np.ndarray    # h/R
     slope_F: np.ndarray  # d ln F/d ln h of the FE curve (errors at fixed h, ``fit.errors``)
     slope_a: np.ndarray  # d ln a/d ln h
+    #: (h/R, F/Hertz) of the FE's elastic hemisphere, the fit's Level I anchor (``fit.level_I_anchor``;
+    #: empty: none, e.g. synthetic data)
+    elastic_sphere: tuple = ()
     cache: dict = field(default_factory=dict, repr=False, compare=False)  # derived per-point arrays
 
     @property
@@ -211,7 +215,8 @@ class Dataset:
 
     def subset(self, keep_runs: Sequence[int]) -> Dataset:
         """A dataset of the runs ``keep_runs`` (indices into ``curves``)."""
-        return build_dataset_from_curves([self.curves[i] for i in keep_runs])
+        return dataclasses.replace(build_dataset_from_curves([self.curves[i] for i in keep_runs]),
+                                   elastic_sphere=self.elastic_sphere)
 
     def without_group(self, group: str) -> Dataset:
         return self.subset([i for i, c in enumerate(self.curves) if c.group != group])
@@ -242,14 +247,15 @@ def _log_slope(h: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def build_dataset(runs: Iterable[tuple[str, object]], per_decade: int = PER_DECADE,
-                  a_min_elements: float = A_MIN_ELEMENTS) -> Dataset:
-    """Dataset of ``(key, run)`` pairs; runs without resolved points are skipped."""
+                  a_min_elements: float = A_MIN_ELEMENTS, elastic_sphere: tuple = ()) -> Dataset:
+    """Dataset of ``(key, run)`` pairs; runs without resolved points are skipped.
+    ``elastic_sphere``: the Level I anchor points (``Dataset.elastic_sphere``)."""
     curves = []
     for key, run in runs:
         c = run_curve(key, run, per_decade, a_min_elements)
         if c is not None:
             curves.append(c)
-    return build_dataset_from_curves(curves)
+    return dataclasses.replace(build_dataset_from_curves(curves), elastic_sphere=tuple(elastic_sphere))
 
 
 def quantities(ds: Dataset, beta: float, growth: float = 0.0) -> dict[str, np.ndarray]:

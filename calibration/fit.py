@@ -23,7 +23,8 @@ measured).
 Constraints (penalty rows): H̄ must not decrease with Λ (``monotonicity_penalty``), so
 that the mean pressure rises with 1/ρ and the two-body κ solve has one root (DESIGN §3);
 the collapse limits must keep F and h rising with a up to a = R (``collapse_penalty``);
-the finite-size factors stay positive up to a = R (``finite_size_penalty``).
+the finite-size factors stay positive up to a = R (``finite_size_penalty``); the elastic sphere
+follows the FE's elastic hemisphere at h/R = 0.002–0.01 (``level_I_anchor``).
 """
 
 from __future__ import annotations
@@ -159,15 +160,40 @@ def finite_size_penalty(co: Coefficients) -> np.ndarray:
     return PENALTY * np.minimum(np.concatenate(f) - FACTOR_MIN, 0.0)
 
 
+#: Level I anchor: F/Hertz of the FE's elastic hemisphere on a rigid flat at these h/R (``make
+#: verify-fem``, reports/fem/fem_verification.json, "F_over_Hertz_at_h"). The calibration points
+#: of Level I are few (Λ < Λ_I at tiny a), so the elastic finite-size factors drift between fits
+#: (on 2026-11-25 the model's elastic sphere was 0.54 % under the FE at h/R = 0.01 without
+#: these rows); the issue target is 0.5 %.
+ELASTIC_SPHERE = ((0.002, 1.022742), (0.005, 1.038703), (0.01, 1.058290))
+ANCHOR_WEIGHT = 100.0
+
+
+def level_I_anchor(co: Coefficients, points=ELASTIC_SPHERE) -> np.ndarray:
+    """ANCHOR_WEIGHT · ln(F_model/F_FE) of the elastic sphere on a flat at the (h/R, F/Hertz)
+    ``points`` (R = 1): p_m = 4E'(a/R)/(3π) f_H(a/R), c² = ½ f_c(a/R), so a² = f_c h R (fixed
+    point) and F/Hertz = (a²/(hR))^(3/2) f_H — the model's Level I (``single.BodyLaw``). The
+    rows are used when the dataset carries them (``Dataset.elastic_sphere``: FE data)."""
+    h = np.array([p[0] for p in points])
+    target = np.array([p[1] for p in points])
+    a = np.sqrt(h)
+    for _ in range(20):
+        a = np.sqrt(levels.finite_size_factor(a, co.finite_size_c2)[0] * h)
+    ratio = (a * a / h) ** 1.5 * levels.finite_size_factor(a, co.finite_size_H_bar)[0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return ANCHOR_WEIGHT * np.log(ratio / target)
+
+
 def _penalty_keys(co: Coefficients) -> tuple:
     """What each penalty depends on: monotonicity (H̄ half-space law), collapse, finite size."""
     fs = (co.finite_size_H_bar, co.finite_size_c2, co.fs_H_bar_plastic, co.fs_c2_plastic)
     return ((co.Lambda_I, co.Lambda_III, co.H_bar_III_prefactor, co.H_bar_III_exp_poly,
              co.H_bar_shape, co.level_II_smooth, fs[0], fs[2]),
-            (co.collapse_H_bar, co.collapse_c2), fs)
+            (co.collapse_H_bar, co.collapse_c2), fs, (fs[0], fs[1]))
 
 
-#: penalty functions in the order of the residual rows, with the key part each one uses
+#: penalty functions in the order of the residual rows, with the key part each one uses (then
+#: the Level I anchor when the dataset has its points)
 _PENALTIES = (monotonicity_penalty, collapse_penalty, finite_size_penalty)
 
 
@@ -178,9 +204,12 @@ def _residuals(form: Form, ds: Dataset):
     rows unchanged: each penalty is recomputed only when the coefficients it depends on
     change (``_penalty_keys``; a small cache per function, same values).
     """
-    n_pen = (1 + MONOTONE_X.size) * MONOTONE_T.size * MONOTONE_N.size + 6 * COLLAPSE_X.size
+    n_pen = ((1 + MONOTONE_X.size) * MONOTONE_T.size * MONOTONE_N.size + 6 * COLLAPSE_X.size
+             + len(ds.elastic_sphere))
     bad = np.full(2 * ds.size + n_pen, 10.0)
-    caches: tuple[dict, ...] = tuple({} for _ in _PENALTIES)
+    penalties = _PENALTIES + ((lambda co: level_I_anchor(co, ds.elastic_sphere),)
+                              if ds.elastic_sphere else ())
+    caches: tuple[dict, ...] = tuple({} for _ in penalties)
 
     def penalty(i: int, key, co: Coefficients) -> np.ndarray:
         cache = caches[i]
@@ -188,7 +217,7 @@ def _residuals(form: Form, ds: Dataset):
         if v is None:
             if len(cache) > 256:
                 cache.clear()
-            v = cache[key] = _PENALTIES[i](co)
+            v = cache[key] = penalties[i](co)
         return v
 
     def f(params):
@@ -200,7 +229,7 @@ def _residuals(form: Form, ds: Dataset):
         keys = _penalty_keys(co)
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.concatenate(list(log_errors(ds, p, c))
-                               + [penalty(i, k, co) for i, k in enumerate(keys)])
+                               + [penalty(i, k, co) for i, k in enumerate(keys[:len(penalties)])])
         return np.where(np.isfinite(r), r, 10.0)
 
     return f

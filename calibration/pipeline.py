@@ -33,7 +33,7 @@ from .check import MonotoneCheck, RunError, check_all, run_errors
 from .crossval import CVResult, RegimeFold, cross_validate_many, cross_validate_regimes
 from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
-from .fit import FitResult, fit, rms, round_sig
+from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
 from .interface import InterfaceFit, fit_interface, load_pairs
 from .threads import single_threaded_blas
@@ -126,14 +126,16 @@ def _warm_start(form: Form, base: FitResult) -> np.ndarray:
 
 def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
                    large_deformation_options: bool = True, source: dict | None = None,
-                   workers: int = DEFAULT_WORKERS, pairs=()) -> Calibration:
+                   workers: int = DEFAULT_WORKERS, pairs=(), elastic_sphere=()) -> Calibration:
     """Fit, cross-validate, choose, check. ``runs``: iterable of ``(key, run)``; the
     independent fits run on ``workers`` processes, with one BLAS thread each whatever the
     environment says (the result depends on neither). ``pairs``: two-body runs
-    (``interface.PairCurve``) for the interface terms of the chosen form (none: left out)."""
+    (``interface.PairCurve``) for the interface terms of the chosen form (none: left out);
+    ``elastic_sphere``: the FE elastic hemisphere's (h/R, F/Hertz), the Level I anchor of the fits
+    (``fit.level_I_anchor``; none: no anchor)."""
     t0 = time.perf_counter()
     with single_threaded_blas():  # the result must not depend on the BLAS thread count (threads.py)
-        ds = build_dataset(runs)
+        ds = build_dataset(runs, elastic_sphere=elastic_sphere)
         timings = {"dataset_s": time.perf_counter() - t0}
         with Workers(ds, workers) as pool:
             cal = _calibrate(ds, pool, candidates, cross_validation, large_deformation_options, timings)
@@ -416,7 +418,8 @@ def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
     pairs = load_pairs(db_path)
     source["pairs"] = [c.name for c in pairs]
     read_s = time.perf_counter() - t0
-    cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs)
+    cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs,
+                         elastic_sphere=ELASTIC_SPHERE)
     cal.timings["read_s"] = read_s
     if out is not None:
         write_json(out, coefficient_file(cal))
