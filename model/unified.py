@@ -208,14 +208,14 @@ class UnifiedPair:
         y = x if self._ratio_rho else a / R
         return law.response(x, y, self._z[id(law)])
 
-    def _g(self, a, u):
-        """g = ln p_1 − ln p_2 at (a, u), its u-derivative, and both responses."""
+    def _g(self, a, u, C=0.0, uA=0.0):
+        """g = ln p_1 − ln p_2 + C (u − u_A) at (a, u), its u-derivative, and both responses
+        (C, u_A: :meth:`_coupling` at a, constants of the κ solve)."""
         w1, w2 = _sigmoid(u)
         r1 = self._body(self.law1, a, w1 / self.R_star, self.s1.radius)
         r2 = self._body(self.law2, a, w2 / self.R_star, self.s2.radius)
         A1 = r1.dlnp_dlnx + (r1.dlnp_dlny if self._ratio_rho else 0.0)
         A2 = r2.dlnp_dlnx + (r2.dlnp_dlny if self._ratio_rho else 0.0)
-        C, _, uA, _ = self._coupling(a)
         g = np.log(r1.p_m) - np.log(r2.p_m) + C * (u - uA)
         return g, A1 * w2 + A2 * w1 + C, r1, r2
 
@@ -223,10 +223,9 @@ class UnifiedPair:
         """C(a) = λ s_1 s_2 e^(−(ln(P_1/P_2)/δ)²) of the interface equation, the anchor
         u_A(a) = u_H/(1 + (a/(a_c R*))^k) and their derivatives in ln a (module docstring), from
         both bodies at the Hertz partition x_i = a/ρ_i,H. λ = 0: (0, 0, 0, 0)."""
-        co = self.coeffs
-        lam = co.interface_coupling
-        if self.mode != "general" or not self._coupled:
+        if not self._coupled:
             return 0.0, 0.0, 0.0, 0.0
+        co = self.coeffs
         s1, d1, P1, m1 = self.law1.plastic_state_at(a / self._rho_hertz[0])
         s2, d2, P2, m2 = self.law2.plastic_state_at(a / self._rho_hertz[1])
         delta = co.interface_similarity
@@ -236,7 +235,7 @@ class UnifiedPair:
             de = np.where(e > 0.0, -2.0 * q * e * (m1 - m2) / delta, 0.0)
             t = (a / (co.interface_radius * self.R_star)) ** co.interface_exponent
         phi = t / (1.0 + t)
-        lam = lam * self._u0**2 / (self._u0**2 + _MODULUS_RATIO**2)  # E-driven only
+        lam = co.interface_coupling * self._u0**2 / (self._u0**2 + _MODULUS_RATIO**2)  # E-driven only
         C = lam * s1 * s2 * e
         dC = lam * ((d1 * s2 + s1 * d2) * e + s1 * s2 * de)
         return C, dC, self._u0 * (1.0 - phi), -self._u0 * co.interface_exponent * phi * (1.0 - phi)
@@ -267,9 +266,10 @@ class UnifiedPair:
         """κ solve: u = ln(ρ_2/ρ_1) with equal mean pressures, for each a (1-D)."""
         a = np.asarray(a, dtype=float)
         u0 = np.full(a.shape, self._u0) if u_guess is None else np.asarray(u_guess, dtype=float)
+        C, _, uA, _ = (np.broadcast_to(v, a.shape) for v in self._coupling(a))  # fixed during the solve
 
         def f(u, idx):
-            g, dg, _, _ = self._g(a[idx], u)
+            g, dg, _, _ = self._g(a[idx], u, C[idx], uA[idx])
             return g, dg
 
         def describe(idx):
