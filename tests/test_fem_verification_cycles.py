@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from spherecontact.fem.verification_cycles import retrace
+from spherecontact.fem.verification_cycles import retrace, retrace_at_same_approach, unloading_approaches
 
 
 def hertz_cycle(bump: float = 0.0) -> dict:
@@ -22,3 +22,32 @@ def test_retrace_is_zero_for_an_exact_elastic_cycle_and_sees_an_offset():
     assert exact["F_max_dev"] < 1e-12  # log-log interpolation is exact for a power law
     (off,) = retrace(hertz_cycle(bump=0.01))
     assert abs(off["F_max_dev"] - 0.01) < 1e-12 and exact["h_res_over_h_max"] == 0.0
+
+
+def kinked_cycle(bump: float = 0.0) -> dict:
+    """A cycle whose F(h) has a slope jump at h = 0.005 (a surface node closing), sampled on
+    loading and unloading at different approaches (unloading F scaled by 1 + bump)."""
+    def F(h):
+        return h**1.5 * np.where(h > 0.005, 1.0 + 40.0 * (h - 0.005), 1.0)
+    load = np.geomspace(1e-4, 0.01, 40)  # fine loading, coarse unloading (as in the FE runs)
+    unload = np.linspace(0.01, 0.0, 8)[1:]
+    h = np.concatenate([[0.0], load, unload])
+    Fh = np.concatenate([[0.0], F(load), (1 + bump) * F(unload)])
+    branch = np.concatenate([[0], np.zeros(40), np.ones(7)]).astype(int)
+    run = {"curves": {"h": h.tolist(), "F": Fh.tolist(), "branch": branch.tolist()},
+           "cycles": {"h_max": [0.01], "F_max": [float(F(0.01))], "h_res": [0.0], "increment_start": [0],
+                      "increment_peak": [40], "increment_end": [47]}}
+    sched = unloading_approaches(run)
+    loading = {"curves": {"h": sched.tolist(), "F": F(sched).tolist(), "branch": [0] * sched.size}}
+    return run, loading
+
+
+def test_retrace_at_the_same_approach_needs_no_interpolation():
+    run, loading = kinked_cycle()
+    (interp,) = retrace(run)
+    assert interp["F_max_dev"] > 0.01  # interpolating across the kink misreads an exact retrace
+    (exact,) = retrace_at_same_approach(run, loading)
+    assert exact["F_max_dev"] < 1e-12 and exact["points"] >= 5
+    run, loading = kinked_cycle(bump=0.002)
+    (off,) = retrace_at_same_approach(run, loading)
+    assert abs(off["F_max_dev"] - 0.002) < 1e-12
