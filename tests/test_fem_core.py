@@ -15,6 +15,7 @@ from spherecontact.fem.plasticity import (
     exp_sym2,
     log_sym2,
     stress_and_tangent,
+    stress_and_tangent_complex,
     stress_update,
 )
 from spherecontact.fem.solver import work_increment
@@ -80,6 +81,24 @@ def test_tangent_matches_finite_differences_and_is_symmetric(mat):
     scale = np.abs(A).max()
     assert np.abs(A - A_fd).max() < 1e-6 * scale
     assert np.abs(A - A.transpose(1, 0, 2)).max() < 1e-12 * scale
+
+
+@pytest.mark.parametrize("mat", MATERIALS + [Material.elastic(200.0, 0.45)])
+@pytest.mark.parametrize("scale", [1e-7, 0.01, 0.1])
+def test_hand_linearised_tangent_equals_the_complex_step_tangent(mat, scale):
+    """Elastic and plastic points, near-equal principal stretches (scale 1e-7: the series
+    branches), large strains, a prestrained state and Newton's frozen elastic points."""
+    F1 = random_F(300, 0.05, seed=4)
+    first, _ = stress_and_tangent_complex(F1, PlasticState.virgin(300), mat)
+    state = PlasticState(first.cp_inv, first.eps_p)
+    F2 = F1 + random_F(300, scale, seed=5) - random_F(300, 0.0, seed=5)
+    frozen = np.arange(300) % 7 == 0
+    for elastic in (None, frozen):
+        upd, A = stress_and_tangent(F2, state, mat, elastic=elastic)
+        _, A_ref = stress_and_tangent_complex(F2, state, mat, real=upd)
+        assert np.abs(A - A_ref).max() < 1e-11 * np.abs(A_ref).max()
+        if elastic is not None and np.isfinite(mat.sigma_y) and scale > 1e-3:
+            assert np.any(upd.dgamma > 0) and np.all(upd.dgamma[frozen] == 0)  # both kinds of points
 
 
 @pytest.mark.parametrize("mat", MATERIALS)
