@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..fem.io import material_from_description
+from ..fem.io import spheres_from_inputs
 from ..model import Sphere, contact
 from ..model.coefficients import Coefficients
 
@@ -73,14 +73,10 @@ class InterfaceFit:
 
 def pair_curve(name: str, run) -> PairCurve | None:
     """The loading points of a two-body run (``fem.io.Run``); None without usable points."""
-    inp = run.inputs
-    R1 = float(inp["radius"])
-    R2 = float(inp.get("radius2", R1))
-    s1 = Sphere(R1, material_from_description(inp["material"]))
-    s2 = Sphere(R2, material_from_description(inp.get("material2", inp["material"])))
+    s1, s2 = spheres_from_inputs(run.inputs, "two_body")
     h, a, h1 = (np.asarray(v, dtype=float) for v in (run.h, run.a, run.curves["h1"]))
     keep = np.asarray(getattr(run, "reference", np.ones(h.size, bool)), dtype=bool)
-    R = min(R1, R2)
+    R = min(s1.radius, s2.radius)
     keep &= (h > 0.0) & (a >= A_MIN * R) & (h <= H_MAX * R * (1.0 + 1e-9))
     if np.count_nonzero(keep) < 2:
         return None

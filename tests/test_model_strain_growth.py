@@ -83,3 +83,16 @@ def test_level_I_follows_the_fe_elastic_sphere_within_half_a_percent():
     F = contact(Sphere(1.0, m), FLAT, h).F
     hertz = 4.0 / 3.0 * m.E_prime * h**1.5
     np.testing.assert_allclose(F / hertz, [fe[k] for k in fe], rtol=0.005)
+
+
+def test_level_I_anchor_rows_are_the_fe_report_s_figures():
+    """calibration.fit.ELASTIC_SPHERE copies F/Hertz of the FE elastic hemisphere from
+    ``make verify-fem``'s report: a re-run that moves them must move the anchor too."""
+    from pathlib import Path
+
+    from spherecontact.calibration.fit import ELASTIC_SPHERE
+
+    fe = json.loads((Path(__file__).resolve().parents[1] / "reports" / "fem" /
+                     "fem_verification.json").read_text())["hertz"]["F_over_Hertz_at_h"]
+    assert [h for h, _ in ELASTIC_SPHERE] == [float(k) for k in fe]
+    np.testing.assert_allclose([v for _, v in ELASTIC_SPHERE], [fe[k] for k in fe], rtol=1e-6)

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.io import loading_mask, material_from_description, reference_mask
+from ..fem.io import loading_mask, reference_mask, spheres_from_inputs
 from ..model import Material, Sphere
 
 __all__ = [
@@ -140,18 +140,9 @@ def scene_of(params: dict, inputs: dict) -> str:
 
 
 def spheres(case: Case) -> tuple[Sphere, Sphere]:
-    """The sphere pair of the FE scene (body 1 is the FE hemisphere of ``radius``)."""
-    s1 = Sphere(float(case.inputs["radius"]), material_from_description(case.inputs["material"]))
-    scene = case.scene
-    if scene == "two_body":
-        m2 = case.inputs.get("material2", case.inputs["material"])
-        return s1, Sphere(float(case.inputs.get("radius2", s1.radius)), material_from_description(m2))
-    if scene == "rigid_sphere":
-        R2 = case.inputs.get("indenter_radius", math.inf)
-        if not math.isfinite(float(R2)):
-            R2 = case.inputs["radius2"]
-        return s1, Sphere(float(R2), Material.rigid())
-    return s1, Sphere(math.inf, Material.rigid())
+    """The sphere pair of the FE scene (body 1 is the FE hemisphere of ``radius``;
+    ``fem.io.spheres_from_inputs``)."""
+    return spheres_from_inputs(case.inputs, case.scene)
 
 
 def reference_radius(case: Case) -> float:
