@@ -55,6 +55,8 @@ CASES = [
     ("rigid sphere R2 = 4, E200, band 0.03, approach penalty 300", 200.0, 4.0, 0.03, APPROACH),
     ("rigid sphere R2 = 0.25, E200, band 0.03, approach penalty 300", 200.0, 0.25, 0.03, APPROACH),
     ("flat E10000, band 0.02, approach penalty 300", 10000.0, math.inf, 0.02, APPROACH),
+    ("flat E10000, band 0.03, approach penalty 100", 10000.0, math.inf, 0.03,
+     {**APPROACH, "penalty": 100.0}),
 ]
 BANDS = ((0.01, 0.03), (0.03, 0.1), (0.1, 0.3), (0.3, 1.2))
 
