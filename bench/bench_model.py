@@ -127,7 +127,33 @@ def main() -> dict:
         "exact_dissimilar_pair": t_dis / t_jg,
     }
     out["target"] = {"fast_contacts_per_s": 1e7, "setup_s": 0.05}
+    out["setup_by_pair"] = setup_by_pair(co)
     out["calibrated_range_checks"] = range_check_overhead(co)
+    return out
+
+
+#: a copper alloy for the setup survey (Ludwik, SI units)
+COPPER = Material(E=120e9, nu=0.34, sigma_y=70e6, K=300e6, n=0.4)
+
+
+def setup_by_pair(co) -> dict:
+    """Table setup (median of 5) and node count of the fast path for several pairs: the table
+    resolution, hence the setup, depends on the pair (radius ratio; the interface terms of
+    pairs whose fully plastic pressures come near each other)."""
+    pairs = {"steel R / aluminium 2R": (Sphere(R, STEEL), Sphere(2 * R, ALU)),
+             "steel R / aluminium R": (Sphere(R, STEEL), Sphere(R, ALU)),
+             "steel 2R / aluminium R": (Sphere(2 * R, STEEL), Sphere(R, ALU)),
+             "copper R / aluminium R": (Sphere(R, COPPER), Sphere(R, ALU)),
+             "steel R / copper 2R": (Sphere(R, STEEL), Sphere(2 * R, COPPER))}
+    out = {}
+    for name, pair in pairs.items():
+        ContactLaw(*pair, coeffs=co)
+        setups = []
+        for _ in range(REPEAT):
+            t0 = time.perf_counter()
+            law = ContactLaw(*pair, coeffs=co)
+            setups.append(time.perf_counter() - t0)
+        out[name] = {"setup_s_median": float(np.median(setups)), "nodes": law.nodes}
     return out
 
 
