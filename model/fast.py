@@ -48,13 +48,28 @@ from .unified import UnifiedPair, UnifiedState, pair
 
 __all__ = ["ContactLaw", "contact_table"]
 
-#: ln(a/R*) step of the regular nodes (halved while the measured error exceeds rtol).
+#: ln(a/R*) step of the regular nodes (halved, in the intervals whose measured error exceeds
+#: rtol, up to three times).
 DEFAULT_STEP = 0.02
 _ONE_SIDED = 1e-8  # offset in ln a for the one-sided slopes at kinks
 _KINK_TOL = 1e-11  # kink location tolerance in ln a
 _KINK_POINTS = 1024  # points per pass of the kink search, shared by the kinks (≥ 16 each)
 _PROBES = (0.21, 0.5, 0.79)  # error probes: fractions of every interval in ln a
 _SAFETY = 2.0      # error bound = safety × largest error found at the probe points
+
+
+def _refine(reg: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """``reg`` with the midpoint added to every one of its intervals that overlaps a table
+    interval [lo, hi] whose measured error is too large (local refinement: the rest of the
+    table keeps its nodes)."""
+    n = reg.size - 1
+    i = np.clip(np.searchsorted(reg, lo, side="right") - 1, 0, n - 1)
+    j = np.clip(np.searchsorted(reg, hi, side="left"), i + 1, n)  # reg intervals i .. j-1
+    mark = np.zeros(n + 1, dtype=np.int64)
+    np.add.at(mark, i, 1)
+    np.add.at(mark, j, -1)
+    idx = np.flatnonzero(np.cumsum(mark)[:n] > 0)
+    return np.sort(np.concatenate([reg, 0.5 * (reg[idx] + reg[idx + 1])]))
 
 
 def _hermite(y0, y1, d0, d1, ds):
@@ -144,14 +159,16 @@ class ContactLaw:
         self.h_min, self.h_max, self.rtol = float(h_min), float(h_max), float(rtol)
         a_lo, a_hi = self.pair.a_from_h(np.array([h_min, h_max]))
         self._lnX = (math.log(a_lo / Rs), math.log(a_hi / Rs))
-        step = DEFAULT_STEP
+        lo_end, hi_end = self._lnX
+        reg = np.linspace(lo_end, hi_end, max(int(math.ceil((hi_end - lo_end) / DEFAULT_STEP)), 1) + 1)
         self._u_grid = None
+        kinks = None
         for _ in range(4):
-            kinks = self._build(step)
-            self.error = self._measure()
-            if max(self.error["F"], self.error["a"], self.error["stiffness"]) <= rtol:
+            kinks = self._build(reg, kinks)
+            self.error, bad = self._measure()
+            if not bad.any():
                 break
-            step *= 0.5
+            reg = _refine(reg, self._lnX_nodes[:-1][bad], self._lnX_nodes[1:][bad])
         self.kinks = np.exp(self._s[np.isin(self._lnX_nodes, kinks)]) if kinks.size else kinks
         self.range_issues: dict[str, str] = {}
         self._range_thresholds()
@@ -208,20 +225,22 @@ class ContactLaw:
         """u = ln(ρ_2/ρ_1) of solved states (None if the pair needs no κ solve)."""
         return np.log(st.rho2 / st.rho1) if self.pair.mode == "general" else None
 
-    def _build(self, step: float) -> np.ndarray:
-        """Nodes, kinks and Hermite coefficients for a regular step in ln(a/R*); returns kinks.
+    def _build(self, reg: np.ndarray, kinks: np.ndarray | None = None) -> np.ndarray:
+        """Nodes, kinks and Hermite coefficients on the regular nodes ``reg`` (increasing
+        ln(a/R*), the table's ends included); returns kinks. ``kinks``: those of a coarser
+        build (a refinement keeps them: they are located to ``_KINK_TOL``), else searched.
 
         Nodes, the one-sided points next to every kink and the error probes of
         :meth:`_measure` are solved together (one vectorised κ solve)."""
-        lo_end, hi_end = self._lnX
-        n = max(int(math.ceil((hi_end - lo_end) / step)), 1)
-        reg = np.linspace(lo_end, hi_end, n + 1)
-        st_reg = self._state(reg, self._u_at(reg))  # warm from the coarser grid when refining
-        if self.pair.mode == "general":
-            self._u_grid = (reg, self._u_of(st_reg))
-        kinks = self._find_kinks(reg, st_reg)
+        if kinks is None:
+            st_reg = self._state(reg, self._u_at(reg))
+            if self.pair.mode == "general":
+                self._u_grid = (reg, self._u_of(st_reg))
+            kinks = self._find_kinks(reg, st_reg)
         if kinks.size:
-            near = np.min(np.abs(reg[:, None] - kinks[None, :]), axis=1) < 0.25 * step
+            gap = np.diff(reg)
+            spacing = np.minimum(np.append(gap, gap[-1]), np.append(gap[0], gap))  # local step
+            near = np.min(np.abs(reg[:, None] - kinks[None, :]), axis=1) < 0.25 * spacing
             near[[0, -1]] = False
             reg = reg[~near]
         lnX = np.unique(np.concatenate([reg, kinks]))
@@ -275,17 +294,20 @@ class ContactLaw:
         self._passes = max(int(np.max(counts)) if counts.size else 1, 1)
         self._s_next = np.append(s[1:], np.inf)  # right end of interval j, guarded
 
-    def _measure(self) -> dict:
-        """Largest relative error at three probes inside every interval (× safety factor)."""
+    def _measure(self) -> tuple[dict, np.ndarray]:
+        """Largest relative error at three probes inside every interval (× safety factor), and
+        the intervals whose F, a or stiffness error exceeds ``rtol`` there (to be refined)."""
         st = self._probe_state  # exact states at the probes, solved by :meth:`_build`
         F, k, a, h1 = self._eval(st.h, full=True)
-        rel = lambda x, y: float(np.max(np.abs(x / y - 1.0)))  # noqa: E731
+        eF, ea, ek = (_SAFETY * np.abs(x / y - 1.0) for x, y in ((F, st.F), (a, st.a), (k, st.stiffness)))
+        n = self._lnX_nodes.size - 1  # probes are ordered fraction by fraction over the intervals
+        bad = (np.maximum(np.maximum(eF, ea), ek) > self.rtol).reshape(len(_PROBES), n).any(axis=0)
         return {
-            "F": _SAFETY * rel(F, st.F),
-            "a": _SAFETY * rel(a, st.a),
-            "stiffness": _SAFETY * rel(k, st.stiffness),
+            "F": float(np.max(eF)),
+            "a": float(np.max(ea)),
+            "stiffness": float(np.max(ek)),
             "h1": _SAFETY * float(np.max(np.abs(h1 - st.h1) / st.h)),
-        }
+        }, bad
 
     # ------------------------------------------------------------------ calibrated range
     def _range_thresholds(self) -> None:
