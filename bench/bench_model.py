@@ -42,6 +42,18 @@ STEEL = Material(E=210e9, nu=0.3, sigma_y=400e6, K=600e6, n=0.3)
 ALU = Material(E=70e9, nu=0.33, sigma_y=100e6, K=200e6, n=0.5)
 
 
+def _setups(pair, co) -> tuple[list[float], ContactLaw]:
+    """``REPEAT`` timed ``ContactLaw`` setups of ``pair`` after one untimed (warm caches of the
+    exact pair), and the last table."""
+    ContactLaw(*pair, coeffs=co)
+    setups = []
+    for _ in range(REPEAT):
+        t0 = time.perf_counter()
+        law = ContactLaw(*pair, coeffs=co)
+        setups.append(time.perf_counter() - t0)
+    return setups, law
+
+
 def _best(fun, repeat=REPEAT) -> float:
     times = []
     for _ in range(repeat):
@@ -93,12 +105,7 @@ def main() -> dict:
     out["exact_dissimilar_pair"] = {"seconds": t_dis, "contacts_per_s": N / t_dis}
 
     for name, pair in (("fast_equal_pair", equal), ("fast_dissimilar_pair", dissimilar)):
-        ContactLaw(*pair, coeffs=co)  # warm caches of the exact pair
-        setups = []
-        for _ in range(REPEAT):
-            t0 = time.perf_counter()
-            law = ContactLaw(*pair, coeffs=co)
-            setups.append(time.perf_counter() - t0)
+        setups, law = _setups(pair, co)
         law.force(h)
         t_fast = _best(lambda law=law: law.force(h))
         out[name] = {
@@ -147,12 +154,7 @@ def setup_by_pair(co) -> dict:
              "steel R / copper 2R": (Sphere(R, STEEL), Sphere(2 * R, COPPER))}
     out = {}
     for name, pair in pairs.items():
-        ContactLaw(*pair, coeffs=co)
-        setups = []
-        for _ in range(REPEAT):
-            t0 = time.perf_counter()
-            law = ContactLaw(*pair, coeffs=co)
-            setups.append(time.perf_counter() - t0)
+        setups, law = _setups(pair, co)
         out[name] = {"setup_s_median": float(np.median(setups)), "nodes": law.nodes}
     return out
 

@@ -281,7 +281,7 @@ def tangent(F, state: PlasticState, material: Material, real: StressUpdate) -> n
     s^tr = 2μ dev ε^tr; the radial return s = (1 − 3μΔγ/q^tr) s^tr with dΔγ = dq^tr/(3μ + H)
     (H = σ_f' at ε_p,n + Δγ; de Souza Neto et al. 2008, Box 7.4); τ = K tr ε I + s;
     P = τ F⁻ᵀ, dF⁻¹ = −F⁻¹ dF F⁻¹. Equals the complex-step derivative
-    (:func:`stress_and_tangent_complex`) to rounding (tests/test_fem_plasticity.py) at a
+    (:func:`stress_and_tangent_complex`) to rounding (tests/test_fem_core.py) at a
     fraction of its cost.
     """
     mu, kappa = material.shear_modulus, material.bulk_modulus

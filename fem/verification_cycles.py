@@ -81,14 +81,21 @@ LIMITS = {"elastic_retrace": 0.001, "energy": 0.01, "convergence": 0.01, "sneddo
           "cycle_cost": 0.20}
 
 
-def run_case(name: str) -> dict:
-    """One FE run of :data:`RUNS`, as plain arrays."""
-    ratio, h_max, unload, density, strain_inc, n_unload, band, *contact = RUNS[name]
+def _solver(name: str) -> IndentationSolver:
+    """The solver of run ``name`` of :data:`RUNS` (material, mesh and options)."""
+    ratio, _, _, density, strain_inc, n_unload, band, *contact = RUNS[name]
     material = Material(E=200.0, nu=NU, sigma_y=math.inf) if math.isinf(ratio) else \
         Material(E=ratio, nu=NU, sigma_y=1.0)
-    solver = IndentationSolver(material, 1.0, density=density, edge_band=band,
-                               options=SolverOptions(strain_increment=strain_inc, unload_increments=n_unload,
-                                                     **(contact[0] if contact else {})))
+    return IndentationSolver(material, 1.0, density=density, edge_band=band,
+                             options=SolverOptions(strain_increment=strain_inc, unload_increments=n_unload,
+                                                   **(contact[0] if contact else {})))
+
+
+def run_case(name: str) -> dict:
+    """One FE run of :data:`RUNS`, as plain arrays."""
+    _, h_max, unload, *_ = RUNS[name]
+    solver = _solver(name)
+    material = solver.material
     res = solver.run(h_max, unload_at=unload)
     keep = ("h", "F", "a", "a_ref", "branch", "dissipation", "work_external", "energy_elastic")
     return {"name": name, "E": material.E, "status": res.status, "wall_s": res.timings["wall_s"],
@@ -108,15 +115,10 @@ def unloading_approaches(run: dict) -> np.ndarray:
 def run_scheduled_case(name: str, schedule) -> dict:
     """One monotone run of :data:`SCHEDULED_RUNS` (the mesh and options of its source run),
     stepped to the approaches ``schedule``."""
-    ratio, h_max, _, density, strain_inc, n_unload, band, *contact = RUNS[SCHEDULED_RUNS[name]]
-    material = Material(E=200.0, nu=NU, sigma_y=math.inf) if math.isinf(ratio) else \
-        Material(E=ratio, nu=NU, sigma_y=1.0)
-    solver = IndentationSolver(material, 1.0, density=density, edge_band=band,
-                               options=SolverOptions(strain_increment=strain_inc, unload_increments=n_unload,
-                                                     **(contact[0] if contact else {})))
+    solver = _solver(SCHEDULED_RUNS[name])
     sched = np.asarray(schedule, dtype=float)
     res = solver.run(float(sched[-1]), schedule=sched)
-    return {"name": name, "E": material.E, "status": res.status, "wall_s": res.timings["wall_s"],
+    return {"name": name, "E": solver.material.E, "status": res.status, "wall_s": res.timings["wall_s"],
             "increments": res.timings["increments"], "n_dofs": solver.disc.n_dofs,
             "curves": {k: np.asarray(res.curves[k]).tolist() for k in ("h", "F", "a", "branch")},
             "cycles": {}}
@@ -415,7 +417,7 @@ def report(res: dict) -> str:
               "shape column compares F/F_max against (h − h_res)/(h_max − h_res).", "",
               "| run | against | h_max/R | h_res % | F_max % | unloading F max |ΔF|/F_max % | "
               "unloading shape max dev % |", "|---|---|---|---|---|---|---|"]
-    lines += [f"| {c['run']} | {c.get('against', 'E200')} | {c['h_max']:g} | {_pct(c['h_res_dev'])} | {_pct(c['F_max_dev'])} | "
+    lines += [f"| {c['run']} | {c['against']} | {c['h_max']:g} | {_pct(c['h_res_dev'])} | {_pct(c['F_max_dev'])} | "
               f"{_pct(c['unloading_F_max_dev_over_F_max'])} | {_pct(c['unloading_shape_max_dev'])} |"
               for c in res["convergence"]]
     lines += ["", "## Thornton (1997) beside the FE", "",
@@ -434,7 +436,7 @@ def report(res: dict) -> str:
     c = res["cost"]
     lines += ["", "## Cost", "", f"E/σY = 200 to h/R = 0.3: {c['wall_monotone_s']:.0f} s monotone, "
               f"{c['wall_with_4_cycles_s']:.0f} s with 4 cycles: {_pct(c['added_per_cycle'])} % per cycle "
-              f"(limit {_pct(LIMITS['cycle_cost'])} %: {'met' if c['added_per_cycle'] <= LIMITS['cycle_cost'] else 'missed'}).", "",
+              f"(limit {_pct(LIMITS['cycle_cost'])} %: {'met' if c['within_limit'] else 'missed'}).", "",
               "![cycles](cycles.png)", ""]
     return "\n".join(lines)
 
