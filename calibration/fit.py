@@ -15,7 +15,8 @@ Every point weighs the same; the points are uniform in ln h per run (``dataset``
 run counts by the decades of h it covers, not by its number of increments.
 
 The fit is deterministic: fixed start values (the form's), a fixed list of restarts
-in the level boundaries, trust-region reflective with the 2-point Jacobian. The
+in the level boundaries, trust-region reflective with the Jacobian of ``jacobian`` (analytic
+in most coefficients, forward differences in β, γ, Λ_I, Λ_III). The
 fitted parameters are rounded to ``SIGNIFICANT`` digits before the coefficient set is
 built, and the residuals are those of the rounded set (what is written is what is
 measured).
@@ -39,6 +40,7 @@ from ..model import levels
 from ..model.coefficients import Coefficients
 from .dataset import Dataset
 from .forms import Form, predict
+from .jacobian import residual_jacobian
 
 __all__ = ["SIGNIFICANT", "FitResult", "fit", "errors", "log_errors", "round_sig", "rms"]
 
@@ -121,7 +123,13 @@ class FitResult:
 
 
 def monotonicity_penalty(co: Coefficients) -> np.ndarray:
-    """PENALTY · min(0, d ln H̄/d ln Λ) over Level II for n in ``MONOTONE_N``.
+    """PENALTY · min(0, d ln H̄/d ln Λ) over Level II for n in ``MONOTONE_N``
+    (:func:`monotonicity_margin`)."""
+    return PENALTY * np.minimum(monotonicity_margin(co), 0.0)
+
+
+def monotonicity_margin(co: Coefficients) -> np.ndarray:
+    """d ln H̄/d ln Λ over Level II for n in ``MONOTONE_N`` (must not be negative).
 
     The two-body κ solve needs p_m to rise with 1/ρ (DESIGN §3), i.e. H̄(Λ) must not
     decrease: a Level II shape that overshoots H̄_III is penalised. Rows: the grid of
@@ -134,11 +142,17 @@ def monotonicity_penalty(co: Coefficients) -> np.ndarray:
     _, _, lf = levels.finite_size_by_level(MONOTONE_X[:, None], s, ds, co.finite_size_H_bar,
                                            co.fs_H_bar_plastic)
     lf = np.tile(np.broadcast_to(lf, (MONOTONE_X.size, L.size)), (1, MONOTONE_N.size))
-    return PENALTY * np.minimum(np.concatenate([sH, (sH + lf).ravel()]), 0.0)
+    return np.concatenate([sH, (sH + lf).ravel()])
 
 
 def collapse_penalty(co: Coefficients) -> np.ndarray:
-    """PENALTY · shortfall of the collapse limits' log slopes on 0 < x ≤ 1.
+    """PENALTY · shortfall of the collapse limits' log slopes on 0 < x ≤ 1
+    (:func:`collapse_margin`)."""
+    return PENALTY * np.minimum(collapse_margin(co), 0.0)
+
+
+def collapse_margin(co: Coefficients) -> np.ndarray:
+    """How far the collapse limits' log slopes stay inside their bounds on 0 < x ≤ 1.
 
     F = π a² p_m and h = a²/(2c²ρ) keep rising in the full-collapse limit if
     d ln H̄_c/d ln x ≥ −2 + SLOPE_MARGIN and d ln c²_c/d ln x ≤ 2 − SLOPE_MARGIN, also
@@ -146,18 +160,22 @@ def collapse_penalty(co: Coefficients) -> np.ndarray:
     in n (x·n terms), so they are checked at both ends of ``MONOTONE_N``.
     """
     if not co.has_collapse:
-        return np.zeros(2 * COLLAPSE_X.size)
+        return np.ones(2 * COLLAPSE_X.size)
     sH = np.atleast_2d(co.collapse_H_bar.log_and_slope(COLLAPSE_X, _N_ENDS)[1]).min(axis=0)
     sc = np.atleast_2d(co.collapse_c2.log_and_slope(COLLAPSE_X, _N_ENDS)[1]).max(axis=0)
-    return PENALTY * np.concatenate([np.minimum(sH + 2.0 - SLOPE_MARGIN, 0.0),
-                                     np.minimum(2.0 - SLOPE_MARGIN - sc, 0.0)])
+    return np.concatenate([sH + 2.0 - SLOPE_MARGIN, 2.0 - SLOPE_MARGIN - sc])
 
 
 def finite_size_penalty(co: Coefficients) -> np.ndarray:
     """PENALTY · shortfall of the finite-size factors below ``FACTOR_MIN`` on 0 ≤ x ≤ 1."""
+    return PENALTY * np.minimum(finite_size_margin(co), 0.0)
+
+
+def finite_size_margin(co: Coefficients) -> np.ndarray:
+    """Finite-size factors minus ``FACTOR_MIN`` on 0 ≤ x ≤ 1."""
     f = [levels.finite_size_factor(COLLAPSE_X, poly)[0] for poly in (
         co.finite_size_H_bar, co.finite_size_c2, co.fs_H_bar_plastic, co.fs_c2_plastic)]
-    return PENALTY * np.minimum(np.concatenate(f) - FACTOR_MIN, 0.0)
+    return np.concatenate(f) - FACTOR_MIN
 
 
 #: Level I anchor: F/Hertz of the FE's elastic hemisphere on a rigid flat at these h/R (``make
@@ -192,53 +210,96 @@ def _penalty_keys(co: Coefficients) -> tuple:
             (co.collapse_H_bar, co.collapse_c2), fs, (fs[0], fs[1]))
 
 
-#: penalty functions in the order of the residual rows, with the key part each one uses (then
-#: the Level I anchor when the dataset has its points)
-_PENALTIES = (monotonicity_penalty, collapse_penalty, finite_size_penalty)
+#: the margins of the penalties in the order of the residual rows (penalty = PENALTY ·
+#: min(margin, 0)), then the Level I anchor (rows as they are) when the dataset has its points
+_MARGINS = (monotonicity_margin, collapse_margin, finite_size_margin)
+#: a penalty whose margins all exceed this is inactive: its rows do not change under a
+#: finite-difference step (parameters move by ~1e-8), so its Jacobian rows are zero
+ACTIVE_MARGIN = 1e-4
 
 
-def _residuals(form: Form, ds: Dataset):
-    """Residual function of ``form`` on ``ds``: data rows, then the penalty rows.
+class Residuals:
+    """Residual function of ``form`` on ``ds``: data rows (r_F, r_a), then the penalty rows;
+    :meth:`jacobian` is its Jacobian (``jacobian.residual_jacobian``).
 
-    A finite-difference Jacobian moves one parameter at a time, which leaves most penalty
-    rows unchanged: each penalty is recomputed only when the coefficients it depends on
-    change (``_penalty_keys``; a small cache per function, same values).
+    Each penalty's margin is recomputed only when the coefficients it depends on change
+    (``_penalty_keys``; a small cache per function, same values): a Jacobian column moves
+    one parameter, which leaves most penalty rows unchanged.
     """
-    n_pen = ((1 + MONOTONE_X.size) * MONOTONE_T.size * MONOTONE_N.size + 6 * COLLAPSE_X.size
-             + len(ds.elastic_sphere))
-    bad = np.full(2 * ds.size + n_pen, 10.0)
-    penalties = _PENALTIES + ((lambda co: level_I_anchor(co, ds.elastic_sphere),)
-                              if ds.elastic_sphere else ())
-    caches: tuple[dict, ...] = tuple({} for _ in penalties)
 
-    def penalty(i: int, key, co: Coefficients) -> np.ndarray:
-        cache = caches[i]
+    def __init__(self, form: Form, ds: Dataset):
+        self.form, self.ds = form, ds
+        n_pen = ((1 + MONOTONE_X.size) * MONOTONE_T.size * MONOTONE_N.size + 6 * COLLAPSE_X.size
+                 + len(ds.elastic_sphere))
+        self._bad = np.full(2 * ds.size + n_pen, 10.0)
+        self._margins = _MARGINS + ((lambda co: level_I_anchor(co, ds.elastic_sphere),)
+                                    if ds.elastic_sphere else ())
+        self._caches: tuple[dict, ...] = tuple({} for _ in self._margins)
+        # the penalties each parameter moves (their coefficients change with it)
+        x0 = form.start()
+        keys0 = _penalty_keys(form.coefficients_unchecked(x0))
+        self.depends: list[tuple[int, ...]] = []
+        for j in range(form.n_params):
+            x = x0.copy()
+            x[j] += 1e-3
+            keys = _penalty_keys(form.coefficients_unchecked(x))
+            self.depends.append(tuple(i for i in range(self.n_penalties) if keys[i] != keys0[i]))
+
+    def coefficients(self, params) -> Coefficients | None:
+        """The coefficient set of ``params`` (None where the parametrisation cannot build one)."""
+        try:
+            return self.form.coefficients_unchecked(params)
+        except ValueError:  # e.g. Λ_I ≥ Λ_III cannot happen with the log parametrisation
+            return None
+
+    def _margin(self, i: int, co: Coefficients) -> np.ndarray:
+        key = _penalty_keys(co)[i]
+        cache = self._caches[i]
         v = cache.get(key)
         if v is None:
             if len(cache) > 256:
                 cache.clear()
-            v = cache[key] = penalties[i](co)
+            v = cache[key] = self._margins[i](co)
         return v
 
-    def f(params):
-        try:
-            co = form.coefficients_unchecked(params)
-        except ValueError:  # e.g. Λ_I ≥ Λ_III cannot happen with the log parametrisation
-            return bad
-        p, c = predict(ds, co)
-        keys = _penalty_keys(co)
+    def penalty_block(self, i: int, co: Coefficients) -> np.ndarray:
+        """Rows of penalty ``i`` (PENALTY · min(margin, 0); the anchor's rows as they are)."""
+        m = self._margin(i, co)
+        return PENALTY * np.minimum(m, 0.0) if i < len(_MARGINS) else m
+
+    def active(self, i: int, co: Coefficients) -> bool:
+        """Whether penalty ``i`` can change under a small step (``ACTIVE_MARGIN``)."""
+        return i >= len(_MARGINS) or bool(np.any(self._margin(i, co) < ACTIVE_MARGIN))
+
+    @property
+    def n_penalties(self) -> int:
+        return len(self._margins)
+
+    def penalty_rows(self, co: Coefficients) -> np.ndarray:
+        return np.concatenate([self.penalty_block(i, co) for i in range(self.n_penalties)])
+
+    def raw_data_rows(self, co: Coefficients) -> np.ndarray:
+        """r_F, r_a of every point (non-finite where the model has no value)."""
+        p, c = predict(self.ds, co)
         with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.concatenate(list(log_errors(ds, p, c))
-                               + [penalty(i, k, co) for i, k in enumerate(keys[:len(penalties)])])
+            return np.concatenate(log_errors(self.ds, p, c))
+
+    def __call__(self, params) -> np.ndarray:
+        co = self.coefficients(params)
+        if co is None:
+            return self._bad
+        r = np.concatenate([self.raw_data_rows(co), self.penalty_rows(co)])
         return np.where(np.isfinite(r), r, 10.0)
 
-    return f
+    def jacobian(self, params) -> np.ndarray:
+        return residual_jacobian(self, params)
 
 
 def _solve(form: Form, ds: Dataset, x0: np.ndarray, max_nfev: int | None, tol: float = TOL):
     lo, hi = form.bounds()
     x0 = np.clip(x0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
-    return least_squares(_residuals(form, ds), x0, bounds=(lo, hi), x_scale="jac",
+    res = Residuals(form, ds)
+    return least_squares(res, x0, jac=res.jacobian, bounds=(lo, hi), x_scale="jac",
                          method="trf", max_nfev=max_nfev or MAX_NFEV, ftol=tol, xtol=tol)
 
 

@@ -33,7 +33,7 @@ from .dataset import Dataset
 #: collapse c²_c is parametrised by its value and slopes at this a/R
 X_C2 = 0.5
 
-__all__ = ["Form", "FORMS", "CANDIDATES", "predict", "predict_exact", "hertz_start"]
+__all__ = ["Form", "FORMS", "CANDIDATES", "predict", "predict_exact", "point_inputs", "hertz_start"]
 
 
 @dataclass(frozen=True)
@@ -257,6 +257,25 @@ def _memo(ds: Dataset, kind: str, key: tuple, make):
     return v
 
 
+def point_inputs(ds: Dataset, co: Coefficients):
+    """Per-point inputs of the level functions, memoised in ``ds.cache``: the effective
+    hardening exponent n, σ_rep, Λ, the elastic mask, the finite-size ratio y (a/R or a/ρ)
+    and z = R/ρ − 1 of the rigid partner (ρ: Hertz relative radius)."""
+    key = ("n_eff", co.eps_lo, co.eps_hi)
+    n_eff = ds.cache.get(key)
+    if n_eff is None:
+        n_eff = ds.cache[key] = _per_point(
+            ds, [0.0 if math.isinf(c.material.sigma_y) else effective_exponent(c.material, co)
+                 for c in ds.curves])
+    sig, Lam, elastic = _memo(ds, "sigma_rep", (co.beta, co.beta_growth),
+                              lambda: _sigma_rep(ds, co.beta, co.beta_growth))
+    y = ds.x_R if co.finite_size_ratio == "a_over_R" else ds.x_rho
+    z = ds.cache.get("z")
+    if z is None:
+        z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
+    return n_eff, sig, Lam, elastic, y, z
+
+
 def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     """Model p_m and c² at the points of ``ds``, all runs in one vectorised pass.
 
@@ -269,18 +288,7 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     Jacobian moves one parameter at a time and leaves most of them unchanged.
     """
     co = coeffs
-    key = ("n_eff", co.eps_lo, co.eps_hi)
-    n_eff = ds.cache.get(key)
-    if n_eff is None:
-        n_eff = ds.cache[key] = _per_point(
-            ds, [0.0 if math.isinf(c.material.sigma_y) else effective_exponent(c.material, co)
-                 for c in ds.curves])
-    sig, Lam, elastic = _memo(ds, "sigma_rep", (co.beta, co.beta_growth),
-                              lambda: _sigma_rep(ds, co.beta, co.beta_growth))
-    y = ds.x_R if co.finite_size_ratio == "a_over_R" else ds.x_rho
-    z = ds.cache.get("z")
-    if z is None:  # R/ρ − 1 of the rigid partner (ρ = Hertz relative radius)
-        z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
+    n_eff, sig, Lam, elastic, y, z = point_inputs(ds, co)
     common = (co.beta, co.beta_growth, co.Lambda_I, co.Lambda_III, co.level_II_smooth, co.finite_size_ratio,
               co.eps_lo, co.eps_hi)
 

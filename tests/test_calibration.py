@@ -11,7 +11,7 @@ import pytest
 from spherecontact.calibration import cli
 from spherecontact.calibration.crossval import cross_validate
 from spherecontact.calibration.dataset import build_dataset, quantities, resample
-from spherecontact.calibration.fit import fit, rms
+from spherecontact.calibration.fit import Residuals, fit, rms
 from spherecontact.calibration.forms import FORMS, predict, predict_exact
 from spherecontact.calibration.pipeline import calibrate, calibrate_runs, coefficient_file, load_runs
 from spherecontact.calibration.synthetic import (
@@ -319,11 +319,19 @@ def test_regime_folds_hold_out_whole_regimes_and_predict_them():
         assert f.runs == len(held) and f.errors["F"].size == sum(c.h.size for c in held)
         assert np.all(np.isfinite(f.errors["F"])), (f.family, f.label)
     # holding out a regime is harder than holding out one material: with 8 model-made runs the
-    # E/σY decade 1e2–1e3 (4 of them) is extrapolated by the rest to 5.5 % RMS in F, and without
-    # the hardening runs the hardening terms are not determined at all (80 %)
+    # E/σY decade 1e2–1e3 (4 of them) is extrapolated by the rest to 5.5 % RMS in F
     by = {(f.family, f.label): rms(f.errors["F"]) for f in folds}
     worst_material = max(rms(f.errors["F"]) for f in cross_validate(ds, full).folds)
     assert by[("E/σY decade", "1e2–1e3")] > worst_material
-    assert by[("K/σY", "0–2")] > 0.3
+    # without the hardening runs the data do not determine the hardening terms or β (n = 0 and
+    # σ_rep = σ_Y at every training point): their Jacobian columns are exactly zero, so what the
+    # fold reports for that regime is the start's hardening terms, not an extrapolation
+    keep = [i for i, c in enumerate(ds.curves) if regime_of(c, "K/σY") != "0–2"]
+    res = Residuals(FORMS["smooth"], ds.subset(keep))
+    J = res.jacobian(full.params)
+    names = FORMS["smooth"].names
+    free = [names.index(n) for n in ("beta", "H_III_n0", "c2_III_n0", "Hc_n0", "c2c_n0")]
+    assert not J[:, free].any()
+    assert np.all(np.abs(np.delete(J, free, axis=1)).max(axis=0) > 0.01)
     with pytest.raises(ValueError, match="regime family"):
         regime_of(ds.curves[0], "colour")

@@ -33,7 +33,7 @@ def test_residuals_with_memoised_parts_equal_a_fresh_evaluation(small_ds):
     """The residual function caches penalties and ``predict`` memoises half-space parts:
     a Jacobian-like sweep (one parameter moved at a time) gives the uncached values."""
     form = FORMS["smooth2_ld3"]
-    f = fitmod._residuals(form, small_ds)
+    f = fitmod.Residuals(form, small_ds)
     p0 = form.start()
     for i in range(form.n_params):
         for step in (1e-3, -2e-3):
@@ -95,3 +95,42 @@ def test_noise_floor_measures_the_scatter_of_the_points():
     e = errors(noisy, KNOWN_CO)
     for q in ("H_bar", "c2"):
         assert nz[q] == pytest.approx(fitmod.rms(e[q]), rel=0.25), q
+
+
+@pytest.mark.parametrize("name", sorted(FORMS))
+def test_jacobian_equals_central_differences(name):
+    """The fit's Jacobian (analytic columns, forward differences in β, γ, Λ_I, Λ_III) against
+    central differences of the residual, at the start values and at a random interior point,
+    with the Level I anchor rows; the residual is evaluated once per numerical column only."""
+    import dataclasses
+    import math
+
+    from spherecontact.calibration.jacobian import NUMERICAL
+    from spherecontact.model import Material
+
+    elastic = [("flat-elastic", Material.elastic(200.0, 0.3), math.inf)]  # Hertz rows (p_m)
+    ds = dataclasses.replace(build_dataset(synthetic_runs(SMALL + elastic, noise=0.002)),
+                             elastic_sphere=fitmod.ELASTIC_SPHERE)
+    form = FORMS[name]
+
+    class Counted(fitmod.Residuals):
+        calls = 0
+
+        def __call__(self, params):
+            Counted.calls += 1
+            return super().__call__(params)
+
+    res = Counted(form, ds)
+    lo, hi = form.bounds()
+    for x in (form.start(), lo + (hi - lo) * np.random.default_rng(3).uniform(0.3, 0.7, lo.size)):
+        Counted.calls = 0
+        J = res.jacobian(x)
+        assert Counted.calls == 1 + sum(n in NUMERICAL for n in form.names)
+        for j in range(form.n_params):
+            h = 1e-6 * max(1.0, abs(x[j]))
+            xp, xm = x.copy(), x.copy()
+            xp[j] += h
+            xm[j] -= h
+            cd = (res(xp) - res(xm)) / (2.0 * h)
+            scale = max(1e-3, float(np.abs(cd).max()))
+            assert np.abs(J[:, j] - cd).max() < 2e-5 * scale, (name, form.names[j])

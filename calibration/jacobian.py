@@ -1,0 +1,262 @@
+"""Jacobian of the fit's residual rows in a form's parameters (``fit.Residuals``).
+
+The data rows r_F = ln p_m + s_F ln c² − (FE) and r_a = s_a ln c² − (FE) (``fit``) depend on
+most parameters through a few per-point quantities (``model.levels``):
+
+    H̄_hs = H̄_q(Λ, n) f_H(x, s),   c²_hs = c²_q(Λ, n) f_c(x, s)       half space
+    f = (1 − s)(1 + Σ e_k x^(k+1)) + s (1 + Σ q_k x^(k+1))           finite size, s = 3t² − 2t³
+    H̄_q = H̄_I + (H̄_III − H̄_I) S(t) + H̄_I L t (1 − t)²               Level II (smooth; S: shape)
+    ln H̄_c, ln c²_c  linear in every coefficient but the sharpness    collapse limits
+    ln H̄ = ln H̄_hs − softplus(k ln r)/k,  ln c² = ln c²_hs + w_c (ln c²_c − ln c²_hs)
+
+with r = H̄_hs/H̄_c, w = σ(k ln r), w_c = σ(k_c (ln r + s_c)). Their derivatives are written
+out here, so a column costs a few array operations instead of an evaluation of the model:
+
+    ∂ln H̄/∂ln H̄_hs = 1 − w,  ∂ln H̄/∂ln H̄_c = w,  ∂ln H̄/∂ln k = softplus(k ln r)/k − w ln r,
+    ∂ln c²/∂ln c²_hs = 1 − w_c,  ∂ln c²/∂ln c²_c = w_c,
+    ∂ln c²/∂ln H̄_hs = −∂ln c²/∂ln H̄_c = (ln c²_c − ln c²_hs) k_c w_c (1 − w_c).
+
+β and γ (ε_rep, hence Λ of every point), Λ_I and Λ_III (the level boundaries) and any
+parameter not named here get forward differences of the whole residual, with the step rule
+of scipy's '2-point' scheme; the penalty rows get forward differences for every parameter,
+those of a penalty that is inactive at the point (every margin above ``fit.ACTIVE_MARGIN``)
+excepted: they are zero (each penalty recomputed only when its coefficients change,
+``fit.Residuals``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..model import levels
+from ..model.coefficients import Coefficients
+from .forms import X_C2, point_inputs
+
+__all__ = ["residual_jacobian", "NUMERICAL"]
+
+#: parameters differentiated numerically: they move Λ or the level boundaries of every point
+NUMERICAL = ("beta", "beta_growth", "ln_Lambda_I", "ln_Lambda_III_over_I")
+_REL_STEP = math.sqrt(np.finfo(float).eps)
+
+
+#: indexed parameter families (name = family + index k)
+_FAMILIES = ("H_III_n", "c2_III_n", "H_shape", "c2_shape", "fs_H", "fs_c2", "fsp_H", "fsp_c2",
+             "Hc_x", "Hc_n", "Hc_z", "Hc_xn", "c2c_x", "c2c_n", "c2c_z", "c2c_xn")
+
+
+def _split(name: str) -> tuple[str, int]:
+    """'Hc_xn1' → ('Hc_xn', 1), 'fs_c21' → ('fs_c2', 1); a name of no family → (name, −1)."""
+    for fam in sorted(_FAMILIES, key=len, reverse=True):
+        rest = name[len(fam):]
+        if name.startswith(fam) and rest.isdigit():
+            return fam, int(rest)
+    return name, -1
+
+
+def fd_step(x: float, lo: float, hi: float) -> float:
+    """Forward step of scipy's '2-point' scheme: √eps · max(1, |x|) with the sign of x, taken
+    backwards when the forward point leaves the bounds; exactly representable (x + h − x)."""
+    h = _REL_STEP * (1.0 if x >= 0.0 else -1.0) * max(1.0, abs(x))
+    if not lo <= x + h <= hi and lo <= x - h <= hi:
+        h = -h
+    return (x + h) - x
+
+
+class _Parts:
+    """The per-point quantities of the module docstring at one coefficient set."""
+
+    def __init__(self, ds, co: Coefficients, tied: bool):
+        n, _, Lam, elastic, y, z = point_inputs(ds, co)
+        self.n, self.y, self.z, self.elastic = n, y, z, elastic
+        lam1, lam3 = co.Lambda_I, co.Lambda_III
+        L = math.log(lam3 / lam1)
+        with np.errstate(divide="ignore"):
+            t = np.clip(np.log(Lam / lam1) / L, 0.0, 1.0)
+        self.t = t
+        lev = levels.level(Lam, co)
+        self.lev2, self.lev3 = lev == 2, lev == 3
+        self.H_III, self.c_III = co.H_bar_III(n), co.c2_III(n)
+        H_q = levels.H_bar_and_slope(Lam, co, n)[0]
+        c_q = levels.c2_and_slope(Lam, co, n)[0]
+        s, ds_l = levels.level_weight(Lam, co)
+        self.s = s
+        self.fH = levels.finite_size_by_level(y, s, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic)[0]
+        self.fc = levels.finite_size_by_level(y, s, ds_l, co.finite_size_c2, co.fs_c2_plastic)[0]
+        self.fH_elastic = levels.finite_size_factor(y, co.finite_size_H_bar)[0]
+        self.tied = tied  # one finite-size coefficient set for all levels (no fsp_ parameters)
+        self.H_q, self.c_q = H_q, c_q
+        self.H_I = co.H_bar_I
+        self.smooth = co.level_II_smooth
+        self.shape_H = self._shape_sum(co.H_bar_shape)
+        self.shape_c = self._shape_sum(co.c2_shape)
+        H_hs, c_hs = H_q * self.fH, c_q * self.fc
+        self.pos = pos = (H_hs > 0.0) & ~elastic
+        zero = np.zeros_like(H_hs)
+        one = np.ones_like(H_hs)
+        if not co.has_collapse:
+            self.A, self.B, self.CcH, self.Ccc = one, zero, zero, one
+            self.dH_dlnk = self.dc_dlnk = self.dc_dlnkc = self.dc_ds = zero
+            return
+        lnHc = co.collapse_H_bar.log_and_slope(y, n, z)[0]
+        lncc = co.collapse_c2.log_and_slope(y, n, z)[0]
+        k = co.collapse_sharpness
+        k_c = co.collapse_sharpness_c2
+        s_c = co.collapse_offset_c2 or 0.0
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            lnr = np.where(pos, np.log(np.where(pos, H_hs, 1.0)) - lnHc, 0.0)
+            w, softplus = levels._weight(k * lnr)
+            kc = k if k_c is None else k_c
+            wc = w if (k_c is None or k_c == k) and not s_c else levels._weight(kc * (lnr + s_c))[0]
+            w, softplus, wc = (np.where(pos, v, 0.0) for v in (w, softplus, wc))
+            gap = np.where(pos & ((w > 0.0) | (wc > 0.0)), lncc - np.log(c_hs), 0.0)
+        dwc = wc * (1.0 - wc)  # dw_c/d(k_c (ln r + s_c))
+        self.A, self.B = 1.0 - w, w
+        self.CcH = gap * kc * dwc
+        self.Ccc = 1.0 - wc
+        self.dH_dlnk = np.where(pos, softplus / k - w * lnr, 0.0)
+        self.dc_dlnkc = gap * dwc * (lnr + s_c) * kc
+        self.dc_dlnk = self.dc_dlnkc if k_c is None else zero
+        self.dc_ds = gap * kc * dwc
+
+    def _shape_sum(self, b):
+        """S(t) of the Level II shape (``levels._shape`` without the slope term m₀) and the
+        factor t²(1 − t)² (smooth) or t(1 − t) (polynomial) that multiplies Σ b_k t^k."""
+        t = self.t
+        u = 1.0 - t
+        P = levels._poly_and_derivative(t, b)[0] if b else np.zeros_like(t)
+        if self.smooth:
+            base = t * t * u * u
+            return t * t * (3.0 - 2.0 * t) + base * P, base
+        base = t * u
+        return t + base * P, base
+
+    # ---- per-parameter derivatives of the parts (relative: d ln(part)/dθ)
+    def half_space_H(self, base: str, k: int, co: Coefficients):
+        """d ln H̄_hs/dθ for the plastic points and d ln p_m/dθ of the elastic (Hertz) points."""
+        n, y = self.n, self.y
+        S, shape_base = self.shape_H
+        d_III = np.where(self.lev3, 1.0, np.where(self.lev2, S, 0.0))  # ∂H̄_q/∂H̄_III
+        elastic = np.zeros_like(n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if base == "H_III" and k < 0:
+                g = d_III * self.H_III / co.H_bar_III_prefactor / self.H_q
+            elif base == "H_III_n":
+                g = d_III * self.H_III * n ** (k + 1) / self.H_q
+            elif base == "H_shape":
+                g = np.where(self.lev2, (self.H_III - self.H_I) * shape_base * self.t ** k, 0.0) / self.H_q
+            elif base in ("fs_H", "fsp_H"):
+                g = self._finite(base == "fs_H", self.fH, k)
+                if base == "fs_H":
+                    elastic = y ** (k + 1) / self.fH_elastic
+            else:
+                raise KeyError(base)
+        return np.where(self.pos, g, 0.0), elastic
+
+    def half_space_c(self, base: str, k: int, co: Coefficients):
+        """d ln c²_hs/dθ."""
+        n = self.n
+        S, shape_base = self.shape_c
+        d_III = np.where(self.lev3, 1.0, np.where(self.lev2, S, 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if base == "c2_III" and k < 0:
+                g = d_III * self.c_III / co.c2_III_prefactor / self.c_q
+            elif base == "c2_III_n":
+                g = d_III * self.c_III * n ** (k + 1) / self.c_q
+            elif base == "c2_shape":
+                rise = self.c_III - levels.C2_HERTZ
+                g = np.where(self.lev2, rise * shape_base * self.t ** k, 0.0) / self.c_q
+            elif base in ("fs_c2", "fsp_c2"):
+                g = self._finite(base == "fs_c2", self.fc, k)
+            else:
+                raise KeyError(base)
+        return np.where(np.isfinite(g), g, 0.0)
+
+    def _finite(self, elastic_coefficient: bool, f, k: int):
+        """d ln f/d e_k (Level I coefficient) or d ln f/d q_k (Level III); both when tied."""
+        weight = 1.0 if self.tied else ((1.0 - self.s) if elastic_coefficient else self.s)
+        return weight * self.y ** (k + 1) / f
+
+
+def _collapse_basis(parts: _Parts, base: str, k: int):
+    """d ln H̄_c/dθ ('H') or d ln c²_c/dθ ('c') of a collapse-limit coefficient, or None."""
+    y, n, z = parts.y, parts.n, parts.z
+    one = np.ones_like(y)
+    table = {
+        "ln_Hc": ("H", lambda: one),
+        "Hc_exponent": ("H", lambda: -np.log(y)),
+        "Hc_x": ("H", lambda: y ** (k + 1)),
+        "Hc_n": ("H", lambda: n ** (k + 1)),
+        "Hc_z": ("H", lambda: z ** (k + 1)),
+        "Hc_xn": ("H", lambda: n * y ** (k + 1)),
+        "ln_c2c": ("c", lambda: one),
+        "c2c_x": ("c", lambda: (y - X_C2) ** (k + 1)),
+        "c2c_n": ("c", lambda: n ** (k + 1)),
+        "c2c_z": ("c", lambda: z ** (k + 1)),
+        "c2c_xn": ("c", lambda: n * (y - X_C2) ** (k + 1)),
+    }
+    if base not in table:
+        return None
+    which, make = table[base]
+    return which, make()
+
+
+def _log_derivatives(parts: _Parts, name: str, co: Coefficients):
+    """(d ln p_m/dθ, d ln c²/dθ) at every point, or None for a numerical column."""
+    base, k = _split(name)
+    zero = np.zeros_like(parts.y)
+    if base in ("H_III", "H_III_n", "H_shape", "fs_H", "fsp_H"):
+        g, elastic = parts.half_space_H(base, k, co)
+        return np.where(parts.elastic, elastic, parts.A * g), parts.CcH * g
+    if base in ("c2_III", "c2_III_n", "c2_shape", "fs_c2", "fsp_c2"):
+        return zero, parts.Ccc * parts.half_space_c(base, k, co)
+    if co.has_collapse:
+        col = _collapse_basis(parts, base, k)
+        if col is not None:
+            which, b = col
+            if which == "H":
+                return np.where(parts.pos, parts.B * b, 0.0), -parts.CcH * b
+            return zero, (1.0 - parts.Ccc) * b
+        if name == "ln_sharpness":
+            return parts.dH_dlnk, parts.dc_dlnk
+        if name == "ln_sharpness_c2":
+            return zero, parts.dc_dlnkc
+        if name == "offset_c2":
+            return zero, parts.dc_ds
+    return None
+
+
+def residual_jacobian(res, x: np.ndarray) -> np.ndarray:
+    """∂r/∂x of ``res`` (a ``fit.Residuals``) at ``x``: analytic columns for the data rows of
+    the parameters above, forward differences elsewhere (module docstring)."""
+    x = np.asarray(x, dtype=float)
+    co0 = res.coefficients(x)
+    r0 = res(x)
+    J = np.zeros((r0.size, x.size))
+    if co0 is None:  # invalid parameters: constant residual
+        return J
+    lo, hi = res.form.bounds()
+    n_data = 2 * res.ds.size
+    finite = np.isfinite(res.raw_data_rows(co0))
+    blocks = [res.penalty_block(i, co0) for i in range(res.n_penalties)]
+    offsets = np.cumsum([n_data] + [b.size for b in blocks])
+    active = [i for i in range(res.n_penalties) if res.active(i, co0)]
+    parts = _Parts(res.ds, co0, tied=not any(n.startswith("fsp_") for n in res.form.names))
+    sF, sa = res.ds.slope_F, res.ds.slope_a
+    for j, name in enumerate(res.form.names):
+        h = fd_step(x[j], lo[j], hi[j])
+        xj = x.copy()
+        xj[j] += h
+        d = None if name in NUMERICAL else _log_derivatives(parts, name, co0)
+        if d is None:
+            J[:, j] = (res(xj) - r0) / h
+            continue
+        dp, dc = d
+        col = np.concatenate([dp + sF * dc, sa * dc])
+        J[:n_data, j] = np.where(finite, col, 0.0)
+        moved = [i for i in res.depends[j] if i in active]
+        co_j = res.coefficients(xj) if moved else None
+        for i in moved if co_j is not None else ():
+            J[offsets[i]:offsets[i + 1], j] = (res.penalty_block(i, co_j) - blocks[i]) / h
+    return J
