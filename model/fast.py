@@ -15,10 +15,14 @@ until it is below ``rtol``. Approaches outside [h_min, h_max] fall back to the e
 solve, so every input gets an answer of known accuracy.
 
 Setup cost is the number of vectorised κ solves (an evaluation of the body responses has a
-fixed cost that dominates at a table's ~600 points): the inversion of the two table ends,
-one solve for the regular grid, one per pass of the kink search (sections per pass chosen
-for the fewest passes, warm-started between the bracket ends) and one for the nodes, the
-one-sided points at kinks and the error probes together (warm-started from the grid).
+fixed cost that dominates at a table's ~600 points): one for the regular grid (from the
+Hertz radii of h_min and h_max, extended where it falls short; its states are the table's
+nodes), one for the two ends (inverse Hermite of the grid and one Newton step of h(a) = h),
+one per pass of the kink search (sections per pass chosen for the fewest passes; pieces
+only, no full states), one for the ends, the kinks, the one-sided points at kinks and the
+error probes together, and one per refinement for the new midpoints and the probes of their
+halves (every other interval keeps its nodes and probes). All but the grid are warm-started
+by the grid's cubic Hermite of u = ln(ρ_2/ρ_1).
 
 Evaluation is a uniform bucket lookup (no binary search), one gather of the interval's
 polynomial coefficients, a Horner step and one exponential: no loops over contacts.
@@ -26,7 +30,8 @@ polynomial coefficients, a Horner step and one exponential: no loops over contac
 Calibrated range (``range_check.py``): material and pair causes warn once, when the
 table is built. The approach-dependent causes (h/R, a/R, Λ_i, flow-table slope) are
 tabulated at build time as their running maximum over the nodes, which gives for each
-cause the approach h where it first leaves the range; an evaluation compares only the
+cause the approach h where it first leaves the range (for h/R, max_i h_i/R_i of the table's
+h_1, within its bound, inside the table); an evaluation compares only the
 largest approach of the call with the smallest of these (one reduction, no per-contact
 work), and a cause found warns once per ``ContactLaw`` (recorded in
 :attr:`ContactLaw.range_issues`) — never per contact or per time step. Approaches outside
@@ -48,28 +53,31 @@ from .unified import UnifiedPair, UnifiedState, pair
 
 __all__ = ["ContactLaw", "contact_table"]
 
-#: ln(a/R*) step of the regular nodes (halved, in the intervals whose measured error exceeds
-#: rtol, up to three times).
+#: ln(a/R*) step of the regular nodes (an interval whose measured error exceeds rtol gets a
+#: node at its midpoint, up to ``_REFINEMENTS`` times).
 DEFAULT_STEP = 0.02
+_REFINEMENTS = 3
 _ONE_SIDED = 1e-8  # offset in ln a for the one-sided slopes at kinks
 _KINK_TOL = 1e-11  # kink location tolerance in ln a
 _KINK_POINTS = 1024  # points per pass of the kink search, shared by the kinks (≥ 16 each)
 _PROBES = (0.21, 0.5, 0.79)  # error probes: fractions of every interval in ln a
 _SAFETY = 2.0      # error bound = safety × largest error found at the probe points
+_BELOW = 2.0       # grid steps of the grid's bottom below the Hertz radius of h_min
+_WIDER = 0.7       # ln a of the grid's top above the Hertz radius of h_max
+_EXTEND = 8        # grid steps added at a time where the grid falls short of an end
+_MAX_EXTEND = 100  # extensions before h(a) is taken not to reach an end (16 in ln a)
+_END_STEP = 1e-6   # largest Newton step (ln a) of an end taken without the exact inversion
 
 
-def _refine(reg: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """``reg`` with the midpoint added to every one of its intervals that overlaps a table
-    interval [lo, hi] whose measured error is too large (local refinement: the rest of the
-    table keeps its nodes)."""
-    n = reg.size - 1
-    i = np.clip(np.searchsorted(reg, lo, side="right") - 1, 0, n - 1)
-    j = np.clip(np.searchsorted(reg, hi, side="left"), i + 1, n)  # reg intervals i .. j-1
-    mark = np.zeros(n + 1, dtype=np.int64)
-    np.add.at(mark, i, 1)
-    np.add.at(mark, j, -1)
-    idx = np.flatnonzero(np.cumsum(mark)[:n] > 0)
-    return np.sort(np.concatenate([reg, 0.5 * (reg[idx] + reg[idx + 1])]))
+def _midpoints(nodes: np.ndarray, bad: np.ndarray) -> np.ndarray:
+    """Midpoints of the intervals [nodes[j], nodes[j + 1]] with ``bad[j]`` (local refinement:
+    the other intervals keep their nodes)."""
+    return 0.5 * (nodes[:-1][bad] + nodes[1:][bad])
+
+
+def _probe_points(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The error probes of the intervals [lo, hi], interval by interval (``_PROBES`` of each)."""
+    return (lo[:, None] + (hi - lo)[:, None] * np.array(_PROBES)[None, :]).ravel()
 
 
 def _hermite(y0, y1, d0, d1, ds):
@@ -78,9 +86,24 @@ def _hermite(y0, y1, d0, d1, ds):
     return np.stack([y0, m0, 3.0 * (y1 - y0) - 2.0 * m0 - m1, 2.0 * (y0 - y1) + m0 + m1], axis=1)
 
 
+def _hermite_at(x, xs, ys, dys):
+    """Cubic Hermite interpolant of (xs, ys) with slopes dys (xs increasing) at x; beyond the
+    ends, the end interval's cubic."""
+    j = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, xs.size - 2)
+    w = xs[j + 1] - xs[j]
+    t = (x - xs[j]) / w
+    c = _hermite(ys[j], ys[j + 1], dys[j], dys[j + 1], w)
+    return c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
+
+
 def _take(st: UnifiedState, sel) -> UnifiedState:
     """The states ``sel`` (slice or indices) of a batch of states."""
     return UnifiedState(*(f[sel] for f in st))
+
+
+def _join(a: UnifiedState, b: UnifiedState) -> UnifiedState:
+    """The batches of states a and b, one after the other."""
+    return UnifiedState(*(np.concatenate([x, y]) for x, y in zip(a, b, strict=True)))
 
 
 def _sections(width: float, kinks: int) -> int:
@@ -157,18 +180,16 @@ class ContactLaw:
         if not rtol > 0.0:
             raise ValueError(f"rtol must be > 0, got {rtol!r}")
         self.h_min, self.h_max, self.rtol = float(h_min), float(h_max), float(rtol)
-        a_lo, a_hi = self.pair.a_from_h(np.array([h_min, h_max]))
-        self._lnX = (math.log(a_lo / Rs), math.log(a_hi / Rs))
-        lo_end, hi_end = self._lnX
-        reg = np.linspace(lo_end, hi_end, max(int(math.ceil((hi_end - lo_end) / DEFAULT_STEP)), 1) + 1)
-        self._u_grid = None
-        kinks = None
-        for _ in range(4):
-            kinks = self._build(reg, kinks)
-            self.error, bad = self._measure()
+        reg, st_reg = self._regular_grid()
+        self._lnX = self._ends(reg, st_reg)
+        kinks = self._find_kinks(reg, st_reg)
+        self._build(reg, st_reg, kinks)
+        self.error, bad = self._measure()
+        for _ in range(_REFINEMENTS):
             if not bad.any():
                 break
-            reg = _refine(reg, self._lnX_nodes[:-1][bad], self._lnX_nodes[1:][bad])
+            self._refine(bad)
+            self.error, bad = self._measure()
         self.kinks = np.exp(self._s[np.isin(self._lnX_nodes, kinks)]) if kinks.size else kinks
         self.range_issues: dict[str, str] = {}
         self._range_thresholds()
@@ -177,26 +198,87 @@ class ContactLaw:
         self.setup_time = time.perf_counter() - t0
 
     # ------------------------------------------------------------------ construction
-    def _state(self, lnX, u_guess=None) -> UnifiedState:
-        """Exact state at a = R* e^lnX; the κ solve starts from ``u_guess`` if given."""
+    def _solve(self, lnX, u_guess=None):
+        """Exact states at a = R* e^lnX and du/d ln a along the κ root (None for scenes
+        without a κ solve); the κ solve starts from ``u_guess`` if given, else from the Hertz
+        root."""
         a = self.pair.R_star * np.exp(lnX)
         if self.pair.mode != "general":
-            return self.pair.state_at_a(a)
-        return self.pair.state_at_a(a, self.pair.solve_u(a, u_guess))
+            return self.pair.state_at_a(a), None
+        return self.pair._two_body_state(a, self.pair.solve_u(a, u_guess))
 
     def _u_at(self, lnX):
-        """Warm start for the κ variable u = ln(ρ_2/ρ_1), interpolated from the last grid
-        (None before the first grid is solved)."""
-        if self.pair.mode != "general" or self._u_grid is None:
+        """Warm start for the κ variable u = ln(ρ_2/ρ_1): cubic Hermite of u and du/d ln a of
+        the regular grid (None for scenes without a κ solve)."""
+        if self._u_grid is None:
             return None
-        return np.interp(lnX, *self._u_grid)
+        return _hermite_at(lnX, *self._u_grid)
+
+    def _regular_grid(self):
+        """Nodes ``DEFAULT_STEP`` apart in ln(a/R*) and their exact states, over radii that
+        cover [h_min, h_max]: from ``_BELOW`` steps below the Hertz radius of h_min (a² = R* h,
+        the small-contact limit) to ``_WIDER`` above that of h_max (plastic contacts are wider),
+        at most one step beyond the end of the domain; extended by ``_EXTEND`` steps at a
+        time while an end falls short. One vectorised κ solve (from the Hertz root)."""
+        Rs, step = self.pair.R_star, DEFAULT_STEP
+        lo = 0.5 * math.log(self.h_min / Rs) - _BELOW * step
+        hi = 0.5 * math.log(self.h_max / Rs) + _WIDER
+        a_max = self.pair.domain.a_max
+        if math.isfinite(a_max):
+            hi = min(hi, math.log(a_max / Rs) + step)
+        reg = lo + step * np.arange(max(int(math.ceil((hi - lo) / step)), 1) + 1)
+        st, du = self._solve(reg)
+        self._u_grid = None if du is None else (reg, self._u_of(st), du)
+        for _ in range(_MAX_EXTEND + 1):
+            if st.h[0] <= self.h_min and st.h[-1] >= self.h_max:
+                return reg, st
+            if st.h[0] > self.h_min:
+                more = reg[0] - step * np.arange(_EXTEND, 0, -1)
+            else:
+                more = reg[-1] + step * np.arange(1, _EXTEND + 1)
+            st_more, du_more = self._solve(more, self._u_at(more))
+            order = np.argsort(np.concatenate([reg, more]))
+            reg, st = np.concatenate([reg, more])[order], _take(_join(st, st_more), order)
+            if du is not None:
+                du = np.concatenate([du, du_more])[order]
+                self._u_grid = (reg, self._u_of(st), du)
+        raise ValueError("the coefficient set gives an approach h(a) that is not increasing "
+                         f"(h = {st.h[0]:.6g} … {st.h[-1]:.6g} over contact radii "
+                         f"{Rs * math.exp(reg[0]):.6g} … {Rs * math.exp(reg[-1]):.6g}, "
+                         f"h_min = {self.h_min:.6g}, h_max = {self.h_max:.6g})")
+
+    def _ends(self, reg: np.ndarray, st: UnifiedState) -> tuple[float, float]:
+        """ln(a/R*) of h_min and h_max: inverse cubic Hermite of the grid (ln a against ln h,
+        slopes 1/(d ln h/d ln a)) and one Newton step of ln h(a) = ln h on the exact states
+        there (error ~ step², ≤ 1e-12 for steps ≤ ``_END_STEP``); the exact inversion
+        (``UnifiedPair.a_from_h``) where the step is larger."""
+        target = np.log([self.h_min, self.h_max])
+        t = _hermite_at(target, np.log(st.h), reg, 1.0 / st.dlnh_dlna)
+        se, _ = self._solve(t, self._u_at(t))
+        dt = (np.log(se.h) - target) / se.dlnh_dlna
+        t = t - dt
+        far = np.abs(dt) > _END_STEP
+        if far.any():
+            t[far] = np.log(self.pair.a_from_h(np.exp(target[far])) / self.pair.R_star)
+        return float(t[0]), float(t[1])
+
+    def _pieces(self, lnX, u_guess=None):
+        """Smooth-piece ids at a = R* e^lnX and the κ variable u there (None for scenes without
+        a κ solve): the κ solve from ``u_guess`` and the bodies' pieces, no full state."""
+        a = self.pair.R_star * np.exp(lnX)
+        if self.pair.mode != "general":
+            return self.pair.piece_at(a), None
+        u = self.pair.solve_u(a, u_guess)
+        return self.pair.piece_at(a, u), u
 
     def _find_kinks(self, grid: np.ndarray, st: UnifiedState) -> np.ndarray:
-        """ln(a/R*) of every piece change of the pair between grid nodes, by multi-section:
-        one vectorised κ solve per pass, warm-started by u interpolated between the ends of
-        each bracket (u = ln(ρ_2/ρ_1) of the last pass)."""
+        """ln(a/R*) of every piece change of the pair between grid nodes inside the table
+        (``self._lnX``), by multi-section: one vectorised κ solve per pass (and the pieces,
+        :meth:`_pieces`), warm-started by u interpolated between the ends of each bracket
+        (u = ln(ρ_2/ρ_1) of the last pass; the grid's Hermite in the first)."""
+        lo_end, hi_end = self._lnX
         piece = st.piece
-        j = np.nonzero(piece[1:] != piece[:-1])[0]
+        j = np.nonzero((piece[1:] != piece[:-1]) & (grid[1:] > lo_end) & (grid[:-1] < hi_end))[0]
         if j.size == 0:
             return np.empty(0)
         lo, hi = grid[j], grid[j + 1]
@@ -206,57 +288,90 @@ class ContactLaw:
         n = _sections(float(np.max(hi - lo)), lo.size)
         frac = np.arange(1, n) / n
         rows = np.arange(lo.size)
+        first_pass = True
         while np.max(hi - lo) > _KINK_TOL:
             pts = lo[:, None] + (hi - lo)[:, None] * frac[None, :]
-            guess = None if u is None else (u_lo[:, None] + (u_hi - u_lo)[:, None] * frac[None, :]).ravel()
-            sp = self._state(pts.ravel(), guess)
-            changed = sp.piece.reshape(pts.shape) != p_lo
+            if u is None:
+                guess = None
+            elif first_pass:
+                guess = self._u_at(pts.ravel())
+            else:
+                guess = (u_lo[:, None] + (u_hi - u_lo)[:, None] * frac[None, :]).ravel()
+            first_pass = False
+            pieces, up = self._pieces(pts.ravel(), guess)
+            changed = pieces.reshape(pts.shape) != p_lo
             first = np.where(changed.any(axis=1), np.argmax(changed, axis=1), frac.size)
             below, above = np.maximum(first - 1, 0), np.minimum(first, frac.size - 1)
             keep_lo, keep_hi = first == 0, first == frac.size
             lo, hi = np.where(keep_lo, lo, pts[rows, below]), np.where(keep_hi, hi, pts[rows, above])
             if u is not None:
-                up = self._u_of(sp).reshape(pts.shape)
+                up = up.reshape(pts.shape)
                 u_lo = np.where(keep_lo, u_lo, up[rows, below])
                 u_hi = np.where(keep_hi, u_hi, up[rows, above])
-        return hi
+        return hi[(hi > lo_end) & (hi < hi_end)]
 
     def _u_of(self, st: UnifiedState):
         """u = ln(ρ_2/ρ_1) of solved states (None if the pair needs no κ solve)."""
         return np.log(st.rho2 / st.rho1) if self.pair.mode == "general" else None
 
-    def _build(self, reg: np.ndarray, kinks: np.ndarray | None = None) -> np.ndarray:
-        """Nodes, kinks and Hermite coefficients on the regular nodes ``reg`` (increasing
-        ln(a/R*), the table's ends included); returns kinks. ``kinks``: those of a coarser
-        build (a refinement keeps them: they are located to ``_KINK_TOL``), else searched.
-
-        Nodes, the one-sided points next to every kink and the error probes of
-        :meth:`_measure` are solved together (one vectorised κ solve)."""
-        if kinks is None:
-            st_reg = self._state(reg, self._u_at(reg))
-            if self.pair.mode == "general":
-                self._u_grid = (reg, self._u_of(st_reg))
-            kinks = self._find_kinks(reg, st_reg)
-        if kinks.size:
-            gap = np.diff(reg)
-            spacing = np.minimum(np.append(gap, gap[-1]), np.append(gap[0], gap))  # local step
-            near = np.min(np.abs(reg[:, None] - kinks[None, :]), axis=1) < 0.25 * spacing
-            near[[0, -1]] = False
-            reg = reg[~near]
-        lnX = np.unique(np.concatenate([reg, kinks]))
+    def _build(self, reg: np.ndarray, st_reg: UnifiedState, kinks: np.ndarray) -> None:
+        """Nodes, their states and slopes, and the error probes of the table: the grid nodes
+        inside the ends (``self._lnX``) that are more than a quarter step from an end or a
+        kink (their states are the grid's), the ends and the kinks. The ends, the kinks, the
+        one-sided points next to every kink and the probes of :meth:`_measure` are solved
+        together (one vectorised κ solve, warm-started from the grid)."""
+        ends = np.array(self._lnX)
+        fixed = np.concatenate([ends, kinks])
+        keep = (reg > ends[0]) & (reg < ends[1])
+        keep &= np.min(np.abs(reg[:, None] - fixed[None, :]), axis=1) >= 0.25 * DEFAULT_STEP
+        lnX = np.concatenate([reg[keep], fixed])
+        order = np.argsort(lnX, kind="stable")
+        lnX = lnX[order]
+        probes = _probe_points(lnX[:-1], lnX[1:])
+        m, nk = fixed.size, kinks.size
+        pts = np.concatenate([fixed, kinks - _ONE_SIDED, kinks + _ONE_SIDED, probes])
+        batch, _ = self._solve(pts, self._u_at(pts))
+        st = _take(_join(_take(st_reg, keep), _take(batch, slice(0, m))), order)
+        slopes = np.array([_log_slopes(st)] * 2)  # [left, right][ln F, ln a, φ][node]
         k = np.nonzero(np.isin(lnX, kinks))[0]
-        probes = np.concatenate([lnX[:-1] + f * np.diff(lnX) for f in _PROBES])
-        m, nk = lnX.size, k.size
-        pts = np.concatenate([lnX, lnX[k] - _ONE_SIDED, lnX[k] + _ONE_SIDED, probes])
-        batch = self._state(pts, self._u_at(pts))
-        st = _take(batch, slice(0, m))
+        for side in (0, 1):  # one-sided at kinks
+            slopes[side][:, k] = _log_slopes(_take(batch, slice(m + side * nk, m + (side + 1) * nk)))
+        self._lnX_nodes, self._node_state, self._slopes = lnX, st, slopes
         self._probe_state = _take(batch, slice(m + 2 * nk, None))
-        # one-sided slopes at kinks: left limit for the interval ending there, right for the next
-        dF_l, da_l, dphi_l = _log_slopes(st)
-        dF_r, da_r, dphi_r = dF_l.copy(), da_l.copy(), dphi_l.copy()
-        for side, (dF, da, dphi) in ((0, (dF_l, da_l, dphi_l)), (1, (dF_r, da_r, dphi_r))):
-            sk = _take(batch, slice(m + side * nk, m + (side + 1) * nk))
-            dF[k], da[k], dphi[k] = _log_slopes(sk)
+        self._assemble()
+
+    def _refine(self, bad: np.ndarray) -> None:
+        """Local refinement: a node at the midpoint of every interval ``bad`` (its probes
+        missed rtol), solved together with the probes of the halves (one vectorised κ solve);
+        every other interval keeps its nodes, slopes and probes."""
+        X = self._lnX_nodes
+        mid = _midpoints(X, bad)
+        left = np.concatenate([X[:-1][bad], mid])
+        right = np.concatenate([mid, X[1:][bad]])
+        pts = np.concatenate([mid, _probe_points(left, right)])
+        batch, _ = self._solve(pts, self._u_at(pts))
+        st_mid = _take(batch, slice(0, mid.size))
+        order = np.argsort(np.concatenate([X, mid]), kind="stable")
+        self._lnX_nodes = np.concatenate([X, mid])[order]
+        self._node_state = _take(_join(self._node_state, st_mid), order)
+        new = np.array(_log_slopes(st_mid))  # midpoints lie inside smooth pieces: one slope
+        self._slopes = np.concatenate([self._slopes, np.stack([new, new])], axis=2)[:, :, order]
+        # probes, interval by interval: the rows of the kept intervals and those of the halves,
+        # ordered by the intervals' left ends
+        P, n_old = len(_PROBES), self._probe_state.a.size
+        rows = np.concatenate([np.arange(n_old).reshape(-1, P)[~bad],
+                               n_old + np.arange(left.size * P).reshape(-1, P)])
+        rows = rows[np.argsort(np.concatenate([X[:-1][~bad], left]), kind="stable")]
+        probes = _join(self._probe_state, _take(batch, slice(mid.size, None)))
+        self._probe_state = _take(probes, rows.ravel())
+        self._assemble()
+
+    def _assemble(self) -> None:
+        """Hermite coefficients of ln F, ln a and φ against s = ln h from the nodes' states and
+        slopes (one-sided at kinks: left limit for the interval ending there, right for the
+        next), the monotonicity checks and the lookup."""
+        st = self._node_state
+        (dF_l, da_l, dphi_l), (dF_r, da_r, dphi_r) = self._slopes
         phi = st.h1 / st.h
         s = np.log(st.h)
         ds = np.diff(s)
@@ -265,8 +380,6 @@ class ContactLaw:
         yF = np.log(st.F)
         if not np.all(np.diff(yF) > 0.0) or not np.all(dF_l > 0.0) or not np.all(dF_r > 0.0):
             raise ValueError("the coefficient set gives a force F(h) that is not increasing")
-        self._lnX_nodes = lnX
-        self._node_state = st
         self._s = s
         self._inv_ds = 1.0 / ds
         self._cF = _hermite(yF[:-1], yF[1:], dF_r[:-1], dF_l[1:], ds)
@@ -278,7 +391,6 @@ class ContactLaw:
         al, be = dF_r[:-1] * ds / dy, dF_l[1:] * ds / dy
         self.monotone = bool(np.all(al**2 + be**2 <= 9.0))
         self._build_lookup()
-        return kinks
 
     def _build_lookup(self) -> None:
         """Uniform buckets in s mapping to the first candidate interval."""
@@ -297,11 +409,11 @@ class ContactLaw:
     def _measure(self) -> tuple[dict, np.ndarray]:
         """Largest relative error at three probes inside every interval (× safety factor), and
         the intervals whose F, a or stiffness error exceeds ``rtol`` there (to be refined)."""
-        st = self._probe_state  # exact states at the probes, solved by :meth:`_build`
+        st = self._probe_state  # exact states at the probes, solved by :meth:`_build`, :meth:`_refine`
         F, k, a, h1 = self._eval(st.h, full=True)
         eF, ea, ek = (_SAFETY * np.abs(x / y - 1.0) for x, y in ((F, st.F), (a, st.a), (k, st.stiffness)))
-        n = self._lnX_nodes.size - 1  # probes are ordered fraction by fraction over the intervals
-        bad = (np.maximum(np.maximum(eF, ea), ek) > self.rtol).reshape(len(_PROBES), n).any(axis=0)
+        n = self._lnX_nodes.size - 1  # probes are ordered interval by interval
+        bad = (np.maximum(np.maximum(eF, ea), ek) > self.rtol).reshape(n, len(_PROBES)).any(axis=1)
         return {
             "F": float(np.max(eF)),
             "a": float(np.max(ea)),
@@ -312,7 +424,8 @@ class ContactLaw:
     # ------------------------------------------------------------------ calibrated range
     def _range_thresholds(self) -> None:
         """Running maximum of every approach-dependent check over the nodes, and the
-        approach where each first exceeds its limit (linear in ln h between nodes)."""
+        approach where each first exceeds its limit (linear in ln h between nodes; the h/R
+        check on the table's h_1 inside the table, :meth:`_approach_limit`)."""
         chk, st = self._check, self._node_state
         vals = chk.values(st)
         self._pending: dict[str, tuple[np.ndarray, float]] = {}
@@ -341,18 +454,30 @@ class ContactLaw:
         """r(h) interpolated linearly in ln h (clamped to the end nodes)."""
         return float(np.interp(math.log(h), self._s, r))
 
+    def _own_ratio(self, h: float, r: np.ndarray) -> float:
+        """max_i h_i/R_i (the h/R check) at approach h: from the table's h_1 inside the table
+        (within the bound ``error["h1"]``), else h · r(h) (r: the nodes' ratio over h, the last
+        node's beyond the table)."""
+        if not self.h_min <= h <= self.h_max:
+            return h * self._ratio_at(r, h)
+        hh = np.array([h])
+        h1 = self._eval(hh, full=True)[3]
+        return float(self._check.approach_ratio(hh, h1, hh - h1)[0])
+
     def _approach_limit(self, r: np.ndarray, lim: float) -> float:
-        """Smallest h with h · r(h) = lim; r > 0 varies slowly with h, so a fixed-point
-        iteration t = lim/r(t) converges in a few steps (beyond the table r is its last node's)."""
+        """Smallest h with max_i h_i/R_i = lim, from r = (running max of max_i h_i/R_i)/h at
+        the nodes: r varies slowly with h (it is constant for a rigid partner and an equal
+        pair), so the fixed-point iteration t = t · lim/ratio(t) (:meth:`_own_ratio`)
+        converges in a few steps from the first node beyond the limit."""
         h = np.exp(self._s)
         above = np.nonzero(h * r > lim)[0]
         if above.size == 0:
             return lim / r[-1] if r[-1] > 0.0 else math.inf
         t = lim / r[above[0]]
-        for _ in range(20):
-            t_new = lim / self._ratio_at(r, t)
+        for _ in range(30):
+            t_new = t * lim / self._own_ratio(t, r)
             if abs(t_new - t) <= 1e-14 * t:
-                break
+                return t_new
             t = t_new
         return t
 
@@ -371,9 +496,8 @@ class ContactLaw:
         for key, (run, t) in self._pending.items():
             if hi <= t:
                 continue
-            v = self._ratio_at(run, hi)
-            if key == "h_over_R":
-                v *= hi  # run holds h_i/R_i over h
+            # run holds h_i/R_i over h for the h/R check, which is read from the table's h_1
+            v = self._own_ratio(hi, run) if key == "h_over_R" else self._ratio_at(run, hi)
             if v > chk.limits[key]:
                 out[key] = v
         return out

@@ -45,7 +45,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
-from .levels import collapse_blend, finite_size_by_level, level_weight, levels_scalar_n
+from .levels import collapse_blend, finite_size_by_level, level, level_weight, levels_scalar_n
 from .material import Material
 
 __all__ = [
@@ -197,6 +197,27 @@ class BodyLaw:
         s, ds = level_weight(mat.E_prime * x / sig, co)
         return s, ds * (1.0 - m), self.H_bar_III * sig, m
 
+    def _piece(self, lev, eps, y) -> np.ndarray:
+        """Smooth-piece id from the level, ε_rep (flow-table segment) and y (beyond x_fit_max)."""
+        piece = lev + 3 * _segment(self.material, eps)
+        if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
+            piece = 2 * piece + (y > self.x_fit_max)
+        return piece
+
+    def piece_at(self, x, y=None) -> np.ndarray:
+        """The smooth-piece id of :meth:`response` at x = a/ρ (finite-size ratio y, default x)
+        without the rest of the response: the level of Λ = E'x/σ_rep (Λ = 0 for an elastic body),
+        the flow-table segment of ε_rep and whether y lies beyond x_fit_max."""
+        mat, co = self.material, self.coeffs
+        x = np.asarray(x, dtype=float)
+        y = x if y is None else np.asarray(y, dtype=float)
+        eps, _ = representative_strain(x, co.beta, co.beta_growth)
+        if math.isinf(mat.sigma_y):
+            Lam = np.zeros_like(x)
+        else:
+            Lam = mat.E_prime * x / mat.flow_stress(eps)
+        return self._piece(level(Lam, co), eps, y)
+
     def response(self, x, y=None, z: float = 0.0) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
         ``z`` the curvature ratio of the collapse limits (a constant of the pair,
@@ -221,9 +242,7 @@ class BodyLaw:
         xm = self.x_fit_max
         fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
         fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
-        piece = lev + 3 * _segment(mat, eps)
-        if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
-            piece = 2 * piece + (y > xm)
+        piece = self._piece(lev, eps, y)
         p, c = p * fH, c * fc
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc

@@ -307,6 +307,20 @@ class UnifiedPair:
             u = self.solve_u(a)
         return self._two_body_state(a, u)[0]
 
+    def piece_at(self, a, u=None) -> np.ndarray:
+        """The ``piece`` of :meth:`state_at_a` at contact radii a (1-D) and, for two deformable
+        bodies, u = ln(ρ_2/ρ_1) (default: the equal pair's 0), from the bodies' ratios alone
+        (no response; the κ solve is the caller's)."""
+        a = np.asarray(a, dtype=float)
+        if self.mode in ("rigid1", "rigid2"):
+            law, R = (self.law1, self.s1.radius) if self.mode == "rigid2" else (self.law2, self.s2.radius)
+            x = a * (1.0 / self.R_star)
+            return law.piece_at(x, x if self._ratio_rho else a / R)
+        w1, w2 = _sigmoid(np.zeros_like(a) if u is None else u)
+        x1, x2 = a * (w1 / self.R_star), a * (w2 / self.R_star)
+        y1, y2 = (x1, x2) if self._ratio_rho else (a / self.s1.radius, a / self.s2.radius)
+        return self.law1.piece_at(x1, y1) + _PIECES * self.law2.piece_at(x2, y2)
+
     def _two_body_state(self, a, u):
         """State of two deformable bodies at (a, u) and du/d ln a along the κ root
         (implicit differentiation of g(u; a) = 0, module docstring)."""

@@ -156,6 +156,20 @@ def test_kinks_are_located_to_the_tolerance(name):
     assert np.all(at != below)
 
 
+@pytest.mark.parametrize("shipped", [False, True])
+@pytest.mark.parametrize("name", ["equal", "rigid_flat", "dissimilar", "table", "strong"])
+def test_pieces_without_the_response_are_the_states_pieces(name, shipped):
+    """The kink search reads the pieces from the bodies' ratios alone (``piece_at``): the same
+    ids as the full states, across levels, flow-table segments and the continuation."""
+    co = default_coefficients() if shipped else CO
+    p = ContactLaw(*BATCH_PAIRS[name], coeffs=co).pair
+    a = p.R_star * np.geomspace(1e-6, 2.0, 4001)
+    u = p.solve_u(a) if p.mode == "general" else None
+    st = p.state_at_a(a, u)
+    assert np.unique(st.piece).size >= 3
+    assert np.array_equal(p.piece_at(a, u), st.piece)
+
+
 @pytest.mark.parametrize("width", [0.02, 0.01, 0.005, 1e-6])
 @pytest.mark.parametrize("kinks", [1, 3, 6, 20, 200])
 def test_kink_search_sections(width, kinks):
@@ -172,11 +186,13 @@ def test_kink_search_sections(width, kinks):
     assert n <= 1.01 * ratio ** (1.0 / passes) + 1.0
 
 
-@pytest.mark.parametrize(("name", "most"), [("dissimilar", 110), ("table", 150), ("equal", 30)])
+@pytest.mark.parametrize(("name", "most"), [("dissimilar", 65), ("table", 90), ("equal", 10)])
 def test_setup_cost_in_body_responses(monkeypatch, name, most):
     """The setup cost is the number of body-response evaluations (each one vectorised over all
-    active points; its fixed cost dominates): 90, 124 and 16 with this coefficient set (178,
-    376 and 114 before the κ solves were batched and warm-started)."""
+    active points; its fixed cost dominates): 56, 78 and 6 with this coefficient set (90, 124
+    and 16 when the table's ends were inverted on their own, the kink search solved full
+    states and every refinement solved the whole table again; 178, 376 and 114 before the κ
+    solves were batched and warm-started)."""
     calls = [0]
     response = BodyLaw.response
 
@@ -187,6 +203,61 @@ def test_setup_cost_in_body_responses(monkeypatch, name, most):
     monkeypatch.setattr(BodyLaw, "response", counted)
     ContactLaw(*BATCH_PAIRS[name], coeffs=CO)
     assert 0 < calls[0] <= most
+
+
+@pytest.mark.parametrize(("name", "shipped"), [("equal", False), ("rigid_flat", False), ("dissimilar", False),
+                                             ("table", False), ("dissimilar", True), ("strong", True)])
+def test_table_ends_are_the_radii_of_h_min_and_h_max(name, shipped):
+    """The first and last nodes are the exact states at h_min and h_max (grid interpolation,
+    ~1e-9 off with the shipped coefficients, and one Newton step of h(a) = h), to 1e-12."""
+    law = ContactLaw(*BATCH_PAIRS[name], coeffs=default_coefficients() if shipped else CO)
+    assert math.exp(law._s[0]) == pytest.approx(law.h_min, rel=1e-12, abs=0.0)
+    assert math.exp(law._s[-1]) == pytest.approx(law.h_max, rel=1e-12, abs=0.0)
+
+
+def _agrees_with_exact(law, s1, s2, co):
+    """The table's ends are h_min and h_max, its bound ≤ rtol and a dense sweep of the exact
+    solve stays within the bound."""
+    assert math.exp(law._s[0]) == pytest.approx(law.h_min, rel=1e-12, abs=0.0)
+    assert math.exp(law._s[-1]) == pytest.approx(law.h_max, rel=1e-12, abs=0.0)
+    assert max(law.error["F"], law.error["a"], law.error["stiffness"]) <= law.rtol
+    h = np.geomspace(law.h_min, law.h_max, 5001)
+    ex, fa = contact(s1, s2, h, co), law(h)
+    for f in ("F", "a", "stiffness"):
+        assert np.max(np.abs(getattr(fa, f) / getattr(ex, f) - 1.0)) <= law.error[f]
+
+
+def test_grid_short_of_the_ends_is_extended(monkeypatch):
+    """A regular grid whose estimated range falls short of both ends (it starts from the Hertz
+    radii) is extended step by step until it covers them; the table is then the same."""
+    s1, s2 = BATCH_PAIRS["strong"]
+    ref = ContactLaw(s1, s2, coeffs=CO)
+    monkeypatch.setattr(fast, "_BELOW", -3.0)   # three steps above the Hertz radius of h_min
+    monkeypatch.setattr(fast, "_WIDER", -0.2)   # below the radius of h_max (plastic: wider)
+    monkeypatch.setattr(fast, "_EXTEND", 2)
+    law = ContactLaw(s1, s2, coeffs=CO)
+    _agrees_with_exact(law, s1, s2, CO)
+    assert law.nodes == ref.nodes
+    assert np.allclose(law._lnX, ref._lnX, rtol=0.0, atol=1e-12)
+
+
+def test_ends_fall_back_to_the_exact_inversion(monkeypatch):
+    """Where the Newton step of an end is larger than _END_STEP, the end is the exact
+    inversion h → a (here forced for both ends)."""
+    s1, s2 = BATCH_PAIRS["dissimilar"]
+    ref = ContactLaw(s1, s2, coeffs=CO)
+    inverted = []
+    a_from_h = type(ref.pair).a_from_h
+
+    def counted(self, h):
+        inverted.append(np.size(h))
+        return a_from_h(self, h)
+    monkeypatch.setattr(type(ref.pair), "a_from_h", counted)
+    monkeypatch.setattr(fast, "_END_STEP", -1.0)  # every step is larger
+    law = ContactLaw(s1, s2, coeffs=CO)
+    assert inverted == [2]
+    _agrees_with_exact(law, s1, s2, CO)
+    assert np.allclose(law._lnX, ref._lnX, rtol=0.0, atol=1e-12)
 
 
 def test_refinement_is_local_and_keeps_the_error_bound():
@@ -205,7 +276,41 @@ def test_refinement_is_local_and_keeps_the_error_bound():
     assert np.max(np.abs(F / contact(s1, s2, h, co).F - 1.0)) <= law.error["F"]
 
 
-def test_refine_adds_midpoints_only_where_asked():
-    reg = np.linspace(0.0, 1.0, 11)
-    out = fast._refine(reg, np.array([0.31, 0.72]), np.array([0.34, 0.8]))
-    assert set(np.round(np.setdiff1d(out, reg), 12)) == {0.35, 0.75}
+def test_refinement_keeps_nodes_and_probes_in_order():
+    """A tighter rtol refines (midpoints of the intervals whose probes miss it, merged with the
+    kept nodes and probes): every node's state is that node's, every interval's probes lie at
+    _PROBES of it, and the bound and the exact solve agree with the table."""
+    s1, s2 = BATCH_PAIRS["table"]
+    coarse = ContactLaw(s1, s2, coeffs=CO)
+    law = ContactLaw(s1, s2, coeffs=CO, rtol=3e-8)
+    assert law.nodes > coarse.nodes + 20
+    X = law._lnX_nodes
+    Rs = law.pair.R_star
+    assert np.allclose(np.log(law._node_state.a / Rs), X, rtol=0.0, atol=1e-14)
+    probes = np.log(law._probe_state.a / Rs).reshape(X.size - 1, len(fast._PROBES))
+    want = X[:-1, None] + np.diff(X)[:, None] * np.array(fast._PROBES)[None, :]
+    assert np.allclose(probes, want, rtol=0.0, atol=1e-14)
+    _agrees_with_exact(law, s1, s2, CO)
+
+
+def test_h_over_R_limit_is_read_from_the_table():
+    """h_calibrated of a dissimilar pair, whose shares h_i/h change with h, is where the exact
+    max_i h_i/R_i reaches the calibrated h/R = 0.3, to the table's bound (interpolating the
+    nodes' h_i/R_i/h linearly in ln h was off by up to ~2e-6, depending on where the nodes
+    fall)."""
+    pp = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    for s2 in (Sphere(3.0, Material(E=500.0, nu=0.25, sigma_y=2.5, K=1.0, n=0.2)),
+               Sphere(2.0, Material.elastic(E=400.0, nu=0.3))):
+        s1 = Sphere(1.0, pp)
+        law = ContactLaw(s1, s2, coeffs=CO)
+        assert law.h_min < law.h_calibrated < law.h_max
+        end = contact(s1, s2, np.array([law.h_calibrated]), CO)
+        own = max(float(end.h1[0]) / s1.radius, float(end.h2[0]) / s2.radius)
+        assert own == pytest.approx(0.3, rel=1e-8, abs=0.0)
+
+
+def test_midpoints_only_where_asked():
+    nodes = np.linspace(0.0, 1.0, 11)
+    bad = np.zeros(10, dtype=bool)
+    bad[[3, 7]] = True
+    assert np.allclose(fast._midpoints(nodes, bad), [0.35, 0.75])
