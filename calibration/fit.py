@@ -16,7 +16,7 @@ run counts by the decades of h it covers, not by its number of increments.
 
 The fit is deterministic: fixed start values (the form's), a fixed list of restarts
 in the level boundaries, trust-region reflective with the Jacobian of ``jacobian`` (analytic
-in most coefficients, forward differences in β, γ, Λ_I, Λ_III). The
+in the coefficients for the data rows, forward differences for the penalty rows). The
 fitted parameters are rounded to ``SIGNIFICANT`` digits before the coefficient set is
 built, and the residuals are those of the rounded set (what is written is what is
 measured).
@@ -235,9 +235,15 @@ class Residuals:
         self._margins = _MARGINS + ((lambda co: level_I_anchor(co, ds.elastic_sphere),)
                                     if ds.elastic_sphere else ())
         self._caches: tuple[dict, ...] = tuple({} for _ in self._margins)
-        # the penalties each parameter moves (their coefficients change with it)
+        # the penalties each parameter moves (their coefficients change with it), and the rows
+        # that are zero whatever the parameters (e.g. d ln H̄/d ln Λ at Λ_III of the smooth
+        # shape): they never make a penalty active
         x0 = form.start()
-        keys0 = _penalty_keys(form.coefficients_unchecked(x0))
+        co0 = form.coefficients_unchecked(x0)
+        keys0 = _penalty_keys(co0)
+        co1 = form.coefficients_unchecked(0.5 * (x0 + np.clip(x0 + 0.1, *form.bounds())))
+        self._structural = tuple((self._margins[i](co0) == 0.0) & (self._margins[i](co1) == 0.0)
+                                 for i in range(len(_MARGINS)))
         self.depends: list[tuple[int, ...]] = []
         for j in range(form.n_params):
             x = x0.copy()
@@ -269,7 +275,9 @@ class Residuals:
 
     def active(self, i: int, co: Coefficients) -> bool:
         """Whether penalty ``i`` can change under a small step (``ACTIVE_MARGIN``)."""
-        return i >= len(_MARGINS) or bool(np.any(self._margin(i, co) < ACTIVE_MARGIN))
+        if i >= len(_MARGINS):
+            return True
+        return bool(np.any(self._margin(i, co)[~self._structural[i]] < ACTIVE_MARGIN))
 
     @property
     def n_penalties(self) -> int:

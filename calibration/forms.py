@@ -27,7 +27,7 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients, CollapseLimit
-from ..model.single import BodyLaw, curvature_ratio, effective_exponent, representative_strain
+from ..model.single import BodyLaw, curvature_ratio, effective_exponent, flow_log_slope, representative_strain
 from .dataset import Dataset
 
 #: collapse c²_c is parametrised by its value and slopes at this a/R
@@ -274,6 +274,18 @@ def point_inputs(ds: Dataset, co: Coefficients):
     if z is None:
         z = ds.cache["z"] = _per_point(ds, [curvature_ratio(c.radius, c.rho) for c in ds.curves])
     return n_eff, sig, Lam, elastic, y, z
+
+
+def flow_log_slope_at(ds: Dataset, co: Coefficients) -> np.ndarray:
+    """m = d ln σ_f/d ln ε_p at every point's ε_rep (0 for elastic bodies), memoised by (β, γ)."""
+    def make():
+        eps = representative_strain(ds.x_rho, co.beta, co.beta_growth)[0]
+        m = np.zeros(ds.size)
+        for i, c in enumerate(ds.curves):
+            sel = ds.run == i
+            m[sel] = flow_log_slope(c.material, eps[sel])
+        return m
+    return _memo(ds, "flow_log_slope", (co.beta, co.beta_growth), make)
 
 
 def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:

@@ -16,12 +16,15 @@ out here, so a column costs a few array operations instead of an evaluation of t
     ∂ln c²/∂ln c²_hs = 1 − w_c,  ∂ln c²/∂ln c²_c = w_c,
     ∂ln c²/∂ln H̄_hs = −∂ln c²/∂ln H̄_c = (ln c²_c − ln c²_hs) k_c w_c (1 − w_c).
 
-β and γ (ε_rep, hence Λ of every point), Λ_I and Λ_III (the level boundaries) and any
-parameter not named here get forward differences of the whole residual, with the step rule
-of scipy's '2-point' scheme; the penalty rows get forward differences for every parameter,
-those of a penalty that is inactive at the point (every margin above ``fit.ACTIVE_MARGIN``)
-excepted: they are zero (each penalty recomputed only when its coefficients change,
-``fit.Residuals``).
+β and γ move σ_rep = σ_f(ε_rep) by m d ln ε_rep (m: the flow curve's log slope) and Λ by the
+opposite, which acts through d ln H̄_hs/d ln Λ and d ln c²_hs/d ln Λ (the level functions' slopes
+and the level weight of the finite-size factors); ln Λ_I and L = ln(Λ_III/Λ_I) move
+t = (ln Λ − ln Λ_I)/L and H̄_I = 4Λ_I/(3π) (``_Parts.level_bounds``). A parameter not named
+here would get forward differences of the whole residual (scipy's '2-point' step rule). The
+penalty rows get forward differences for every parameter they depend on, those of a penalty
+that is inactive at the point (every margin above ``fit.ACTIVE_MARGIN``, rows that are zero
+whatever the parameters aside) excepted: they are zero (each penalty recomputed only when its
+coefficients change, ``fit.Residuals``).
 """
 
 from __future__ import annotations
@@ -32,12 +35,10 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import Coefficients
-from .forms import X_C2, point_inputs
+from .forms import X_C2, flow_log_slope_at, point_inputs
 
-__all__ = ["residual_jacobian", "NUMERICAL"]
+__all__ = ["residual_jacobian"]
 
-#: parameters differentiated numerically: they move Λ or the level boundaries of every point
-NUMERICAL = ("beta", "beta_growth", "ln_Lambda_I", "ln_Lambda_III_over_I")
 _REL_STEP = math.sqrt(np.finfo(float).eps)
 
 
@@ -78,12 +79,16 @@ class _Parts:
         lev = levels.level(Lam, co)
         self.lev2, self.lev3 = lev == 2, lev == 3
         self.H_III, self.c_III = co.H_bar_III(n), co.c2_III(n)
-        H_q = levels.H_bar_and_slope(Lam, co, n)[0]
-        c_q = levels.c2_and_slope(Lam, co, n)[0]
+        H_q, self.sH = levels.H_bar_and_slope(Lam, co, n)
+        c_q, self.sc = levels.c2_and_slope(Lam, co, n)
         s, ds_l = levels.level_weight(Lam, co)
         self.s = s
-        self.fH = levels.finite_size_by_level(y, s, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic)[0]
-        self.fc = levels.finite_size_by_level(y, s, ds_l, co.finite_size_c2, co.fs_c2_plastic)[0]
+        self.fH, _, self.lfH = levels.finite_size_by_level(y, s, ds_l, co.finite_size_H_bar,
+                                                           co.fs_H_bar_plastic)
+        self.fc, _, self.lfc = levels.finite_size_by_level(y, s, ds_l, co.finite_size_c2, co.fs_c2_plastic)
+        self.L = L
+        self.m, self.x_rho = flow_log_slope_at(ds, co), ds.x_rho
+        self.beta, self.growth = co.beta, co.beta_growth
         self.fH_elastic = levels.finite_size_factor(y, co.finite_size_H_bar)[0]
         self.tied = tied  # one finite-size coefficient set for all levels (no fsp_ parameters)
         self.H_q, self.c_q = H_q, c_q
@@ -173,6 +178,35 @@ class _Parts:
                 raise KeyError(base)
         return np.where(np.isfinite(g), g, 0.0)
 
+    def level_bounds(self, name: str):
+        """d ln H̄_hs/dθ and d ln c²_hs/dθ for θ = ln Λ_I or L = ln(Λ_III/Λ_I), Λ fixed.
+
+        t = (ln Λ − ln Λ_I)/L, so ∂t/∂ln Λ_I = −1/L and ∂t/∂L = −t/L; in Level II
+        H̄_q = H̄_I (1 − S(t) + L t (1 − t)²) + H̄_III S(t) (smooth; the polynomial shape has
+        no L term) with H̄_I = 4Λ_I/(3π), c²_q = ½ + (c²_III − ½) S_c(t); the level weight of
+        the finite-size factors moves with t as well (d ln f/d ln Λ = ``lf``).
+        """
+        t, u, L = self.t, 1.0 - self.t, self.L
+        S = self.shape_H[0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if name == "ln_Lambda_I":
+                own = self.H_I * (1.0 - S + (L * t * u * u if self.smooth else 0.0)) / self.H_q
+                gH = np.where(self.lev2, own - self.sH, 0.0) - self.lfH
+                gc = np.where(self.lev2, -self.sc, 0.0) - self.lfc
+            else:
+                own = self.H_I * t * u * u / self.H_q if self.smooth else 0.0
+                gH = np.where(self.lev2, own - t * self.sH, 0.0) - t * self.lfH
+                gc = np.where(self.lev2, -t * self.sc, 0.0) - t * self.lfc
+        return np.where(self.pos, gH, 0.0), np.where(self.pos, gc, 0.0)
+
+    def strain(self, name: str):
+        """d ln σ_rep/dθ for θ = β or γ of ε_rep = β x (1 + γ x): m d ln ε_rep/dθ, with m the
+        flow curve's log slope at ε_rep (``single.flow_log_slope``); Λ = E'x/σ_rep moves by
+        −d ln σ_rep."""
+        x = self.x_rho
+        dln_eps = 1.0 / self.beta if name == "beta" else x / (1.0 + self.growth * x)
+        return np.where(self.pos, self.m * dln_eps, 0.0)
+
     def _finite(self, elastic_coefficient: bool, f, k: int):
         """d ln f/d e_k (Level I coefficient) or d ln f/d q_k (Level III); both when tied."""
         weight = 1.0 if self.tied else ((1.0 - self.s) if elastic_coefficient else self.s)
@@ -206,6 +240,13 @@ def _log_derivatives(parts: _Parts, name: str, co: Coefficients):
     """(d ln p_m/dθ, d ln c²/dθ) at every point, or None for a numerical column."""
     base, k = _split(name)
     zero = np.zeros_like(parts.y)
+    if name in ("ln_Lambda_I", "ln_Lambda_III_over_I"):
+        gH, gc = parts.level_bounds(name)
+        return parts.A * gH, parts.CcH * gH + parts.Ccc * gc
+    if name in ("beta", "beta_growth"):  # σ_rep moves, Λ by −d ln σ_rep
+        dsig = parts.strain(name)
+        gH, gc = parts.sH + parts.lfH, parts.sc + parts.lfc
+        return dsig * (1.0 - parts.A * gH), -dsig * (parts.CcH * gH + parts.Ccc * gc)
     if base in ("H_III", "H_III_n", "H_shape", "fs_H", "fsp_H"):
         g, elastic = parts.half_space_H(base, k, co)
         return np.where(parts.elastic, elastic, parts.A * g), parts.CcH * g
@@ -248,7 +289,7 @@ def residual_jacobian(res, x: np.ndarray) -> np.ndarray:
         h = fd_step(x[j], lo[j], hi[j])
         xj = x.copy()
         xj[j] += h
-        d = None if name in NUMERICAL else _log_derivatives(parts, name, co0)
+        d = _log_derivatives(parts, name, co0)
         if d is None:
             J[:, j] = (res(xj) - r0) / h
             continue
