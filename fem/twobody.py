@@ -32,7 +32,6 @@ from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..model.material import Material
 from .assembly import Discretisation, positive_jacobian
@@ -353,7 +352,7 @@ class TwoBodySolver(CycleLegs):
             system = sp.bmat([[K[free][:, free], -scale * Gf.T],
                               [-scale * Gf, sp.csr_matrix((n_act, n_act))]], format="csc")
             rhs = np.concatenate([-f[free], scale * kin.gap[active]])
-            sol = spla.splu(system, permc_spec="COLAMD").solve(rhs)
+            sol = self.linear.solve_saddle(system, rhs, n_act)  # LDLᵀ + refinement, SuperLU fallback
             du = np.zeros(nd)
             du[free] = sol[:free.sum()]
             lam = np.zeros_like(lam)

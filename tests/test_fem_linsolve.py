@@ -142,3 +142,66 @@ def test_ldl_and_superlu_give_the_same_run(indenter):
     # every later factorisation (rejected increments' included) reuses the first analysis
     assert a.timings["linear_ldl_update"] >= a.timings["newton_iterations"] - 1
     assert a.timings["linear_fallback"] == 0 and b.timings["linear_superlu"] >= b.timings["newton_iterations"]
+
+
+def _saddle(n: int = 6, m: int = 3, seed: int = 0):
+    """[[K, Bᵀ], [B, 0]] with K an SPD Laplacian (n² dofs) and m constraint rows."""
+    K = _laplacian(n)
+    rng = np.random.default_rng(seed)
+    B = sp.csr_matrix(rng.standard_normal((m, K.shape[0])) * (rng.random((m, K.shape[0])) < 0.2))
+    A = sp.bmat([[K, B.T], [B, sp.csr_matrix((m, m))]], format="csc")
+    return A, rng.standard_normal(A.shape[0])
+
+
+def test_the_saddle_point_system_the_plain_ldl_cannot_factor_is_solved_by_regularised_ldl():
+    """The multiplier block that defeats LDLᵀ without pivoting (test above) is factored as the
+    quasi-definite A − δI: no SuperLU, the refinement on A brings the residual to rounding, and a
+    second matrix of the same pattern reuses the analysis."""
+    A, b = _saddle()
+    s = SymmetricSolver("ldl")
+    x = s.solve_saddle(A, b, 3)
+    assert np.abs(A @ x - b).max() < 1e-12 * np.abs(b).max()
+    assert np.allclose(x, spla.spsolve(A, b), rtol=1e-10, atol=1e-12)
+    x2 = s.solve_saddle(2.0 * A, b, 3)
+    assert np.allclose(x2, 0.5 * x, rtol=1e-10, atol=1e-12)
+    assert s.stats == {"ldl_fresh": 1, "ldl_update": 1, "fallback": 0, "superlu": 0}
+
+
+def test_the_regularisation_is_refined_away(monkeypatch):
+    """With a large δ the first LDLᵀ solution misses the rtol of the check; the refinement steps
+    on A recover the exact solution without SuperLU."""
+    import spherecontact.fem.linsolve as ls
+
+    monkeypatch.setattr(ls, "REGULARISATION", 1e-4)
+    A, b = _saddle()
+    s = SymmetricSolver("ldl")
+    x = s.solve_saddle(A, b, 3)
+    first = s._solver.solve(b)  # the regularised solution alone
+    assert np.abs(A @ first - b).max() > ls.RTOL * np.abs(b).max()
+    assert np.abs(A @ x - b).max() <= ls.RTOL * np.abs(b).max()
+    assert s.stats["fallback"] == 0
+
+
+def test_a_saddle_point_system_beyond_the_refinement_falls_back_to_superlu(monkeypatch):
+    """A δ so large that three refinement steps cannot reach rtol: SuperLU answers, counted."""
+    import spherecontact.fem.linsolve as ls
+
+    monkeypatch.setattr(ls, "REGULARISATION", 10.0)
+    A, b = _saddle()
+    s = SymmetricSolver("ldl")
+    x = s.solve_saddle(A, b, 3)
+    assert np.abs(A @ x - b).max() < 1e-10 * np.abs(b).max()
+    assert s.stats["fallback"] == 1
+
+
+def test_saddle_and_plain_solves_share_one_solver():
+    """A two-body run alternates systems without constraints (plain LDLᵀ on the union pattern)
+    and with them (regularised LDLᵀ on the exact pattern): each path keeps to its own analysis."""
+    A, b = _saddle()
+    K = _laplacian(6)
+    s = SymmetricSolver("ldl")
+    for sys_, m in ((K, 0), (A, 3), (K, 0), (K, 0), (A, 3)):
+        rhs = b[:sys_.shape[0]]
+        x = s.solve_saddle(sys_, rhs, m)
+        assert np.abs(sys_ @ x - rhs).max() < 1e-10 * np.abs(rhs).max()
+    assert s.stats["fallback"] == 0 and s.stats["ldl_fresh"] == 4 and s.stats["ldl_update"] == 1
