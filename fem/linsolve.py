@@ -94,7 +94,8 @@ class SymmetricSolver:
                 self._last = (upper.indptr.copy(), upper.indices.copy(), pos)
                 self._update_at(pos, upper.data)
                 return
-            keys = np.union1d(self._keys, own)
+            new = own[~inside]  # sorted, like the stored keys: merge by insertion
+            keys = np.insert(self._keys, np.searchsorted(self._keys, new), new)
         self._keys = np.asarray(keys, dtype=np.int64)
         self._n = n
         cols_u, self._rows = np.divmod(self._keys, n)

@@ -263,6 +263,10 @@ class TwoBodySolver(CycleLegs):
         self.free = np.ones(self.n_dofs, dtype=bool)
         self.free[self.fixed] = False
         self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+        # the block-diagonal CSR pattern of both bodies' tangents (each body's is fixed)
+        (p1, i1), (p2, i2) = (b.disc.csr_pattern for b in self.bodies)
+        self._K_indptr = np.concatenate([p1, p2[1:] + p1[-1]]).astype(np.int64)
+        self._K_indices = np.concatenate([i1, i2 + self.bodies[0].n_dofs]).astype(np.int64)
         self._elastic = None
 
     # ------------------------------------------------------------------ bodies
@@ -303,8 +307,9 @@ class TwoBodySolver(CycleLegs):
         t0 = time.perf_counter()
         per_body, f = self._stress(u, states, known)
         t1 = time.perf_counter()
-        K = sp.block_diag([b.disc.tangent(A) for b, (_, _, A) in zip(self.bodies, per_body, strict=True)],
-                          format="csr")
+        data = np.concatenate([b.disc.tangent(A).data
+                               for b, (_, _, A) in zip(self.bodies, per_body, strict=True)])
+        K = sp.csr_matrix((data, self._K_indices, self._K_indptr), shape=(self.n_dofs,) * 2)
         self.timers["constitutive"] += t1 - t0
         self.timers["assembly"] += time.perf_counter() - t1
         return per_body, f, K
