@@ -161,24 +161,8 @@ class SymmetricSolver:
         reg = np.zeros(n)
         reg[n - m:] = -REGULARISATION * max(float(np.abs(d[:n - m]).max(initial=0.0)), 1e-300)
         M = sp.csc_matrix(A + sp.diags(reg))
-        return self._checked(b, lambda: self._factor_exact_pattern(M), lambda x: A @ x, lambda: A,
+        return self._checked(b, lambda: self._factor(M), lambda x: A @ x, lambda: A,
                              refinements=REFINEMENTS)
-
-    def _factor_exact_pattern(self, M: sp.csc_matrix) -> None:
-        """Factor M, on the stored analysis when its upper triangle has exactly the stored
-        pattern (no union of patterns: a saddle-point system changes size with its active set,
-        and comparing two index arrays costs less than merging them)."""
-        U = sp.triu(M, format="csc")
-        U.sort_indices()
-        old = self._pattern
-        if (self._solver is not None and isinstance(old, tuple) and len(old) == 2
-                and np.array_equal(old[0], U.indptr) and np.array_equal(old[1], U.indices)):
-            self._solver.update(U, upper=True)
-            self.stats["ldl_update"] += 1
-            return
-        self._solver = qdldl.Solver(U, upper=True)
-        self._pattern, self._keys, self._last = (U.indptr.copy(), U.indices.copy()), None, None
-        self.stats["ldl_fresh"] += 1
 
     def _checked(self, b: np.ndarray, factor, matvec, full, refinements: int = 0) -> np.ndarray:
         """``factor()`` then the LDLᵀ solution, improved by up to ``refinements`` steps of
