@@ -47,6 +47,11 @@ _FAMILIES = ("H_III_n", "c2_III_n", "H_shape", "c2_shape", "fs_H", "fs_c2", "fsp
              "Hc_x", "Hc_n", "Hc_z", "Hc_xn", "c2c_x", "c2c_n", "c2c_z", "c2c_xn")
 
 
+#: the half-space parameter families of H̄ and c² and what they are (``_Parts._level_values``)
+_HALF_SPACE_H = {"H_III": "III", "H_III_n": "III_n", "H_shape": "shape", "fs_H": "fs", "fsp_H": "fsp"}
+_HALF_SPACE_C = {"c2_III": "III", "c2_III_n": "III_n", "c2_shape": "shape", "fs_c2": "fs", "fsp_c2": "fsp"}
+
+
 def _split(name: str) -> tuple[str, int]:
     """'Hc_xn1' → ('Hc_xn', 1), 'fs_c21' → ('fs_c2', 1); a name of no family → (name, −1)."""
     for fam in sorted(_FAMILIES, key=len, reverse=True):
@@ -138,44 +143,36 @@ class _Parts:
         return t + base * P, base
 
     # ---- per-parameter derivatives of the parts (relative: d ln(part)/dθ)
-    def half_space_H(self, base: str, k: int, co: Coefficients):
-        """d ln H̄_hs/dθ for the plastic points and d ln p_m/dθ of the elastic (Hertz) points."""
-        n, y = self.n, self.y
-        S, shape_base = self.shape_H
-        d_III = np.where(self.lev3, 1.0, np.where(self.lev2, S, 0.0))  # ∂H̄_q/∂H̄_III
-        elastic = np.zeros_like(n)
+    def _level_values(self, kind: str, k: int, q_III, prefactor: float, q_q, q_I, shape, f):
+        """d ln q_hs/dθ of the half-space value q = H̄ or c² for θ its Level III prefactor
+        (``kind`` 'III'), n-coefficient k ('III_n'), Level II shape coefficient k ('shape') or
+        finite-size coefficient k of Level I ('fs') or III ('fsp'); q_III, q_q, q_I: its
+        Level III, half-space (no finite size) and Level I values, ``shape`` = (S(t), its
+        shape-term factor), f its finite-size factor."""
+        S, shape_base = shape
+        d_III = np.where(self.lev3, 1.0, np.where(self.lev2, S, 0.0))  # ∂q_q/∂q_III
         with np.errstate(divide="ignore", invalid="ignore"):
-            if base == "H_III" and k < 0:
-                g = d_III * self.H_III / co.H_bar_III_prefactor / self.H_q
-            elif base == "H_III_n":
-                g = d_III * self.H_III * n ** (k + 1) / self.H_q
-            elif base == "H_shape":
-                g = np.where(self.lev2, (self.H_III - self.H_I) * shape_base * self.t ** k, 0.0) / self.H_q
-            elif base in ("fs_H", "fsp_H"):
-                g = self._finite(base == "fs_H", self.fH, k)
-                if base == "fs_H":
-                    elastic = y ** (k + 1) / self.fH_elastic
-            else:
-                raise KeyError(base)
+            if kind == "III":
+                return d_III * q_III / prefactor / q_q
+            if kind == "III_n":
+                return d_III * q_III * self.n ** (k + 1) / q_q
+            if kind == "shape":
+                return np.where(self.lev2, (q_III - q_I) * shape_base * self.t ** k, 0.0) / q_q
+            if kind in ("fs", "fsp"):
+                return self._finite(kind == "fs", f, k)
+        raise KeyError(kind)
+
+    def half_space_H(self, kind: str, k: int, co: Coefficients):
+        """d ln H̄_hs/dθ for the plastic points and d ln p_m/dθ of the elastic (Hertz) points."""
+        g = self._level_values(kind, k, self.H_III, co.H_bar_III_prefactor, self.H_q, self.H_I,
+                               self.shape_H, self.fH)
+        elastic = self.y ** (k + 1) / self.fH_elastic if kind == "fs" else np.zeros_like(self.n)
         return np.where(self.pos, g, 0.0), elastic
 
-    def half_space_c(self, base: str, k: int, co: Coefficients):
-        """d ln c²_hs/dθ."""
-        n = self.n
-        S, shape_base = self.shape_c
-        d_III = np.where(self.lev3, 1.0, np.where(self.lev2, S, 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            if base == "c2_III" and k < 0:
-                g = d_III * self.c_III / co.c2_III_prefactor / self.c_q
-            elif base == "c2_III_n":
-                g = d_III * self.c_III * n ** (k + 1) / self.c_q
-            elif base == "c2_shape":
-                rise = self.c_III - levels.C2_HERTZ
-                g = np.where(self.lev2, rise * shape_base * self.t ** k, 0.0) / self.c_q
-            elif base in ("fs_c2", "fsp_c2"):
-                g = self._finite(base == "fs_c2", self.fc, k)
-            else:
-                raise KeyError(base)
+    def half_space_c(self, kind: str, k: int, co: Coefficients):
+        """d ln c²_hs/dθ (elastic points included: their c² carries the finite-size factor)."""
+        g = self._level_values(kind, k, self.c_III, co.c2_III_prefactor, self.c_q, levels.C2_HERTZ,
+                               self.shape_c, self.fc)
         return np.where(np.isfinite(g), g, 0.0)
 
     def level_bounds(self, name: str):
@@ -247,11 +244,11 @@ def _log_derivatives(parts: _Parts, name: str, co: Coefficients):
         dsig = parts.strain(name)
         gH, gc = parts.sH + parts.lfH, parts.sc + parts.lfc
         return dsig * (1.0 - parts.A * gH), -dsig * (parts.CcH * gH + parts.Ccc * gc)
-    if base in ("H_III", "H_III_n", "H_shape", "fs_H", "fsp_H"):
-        g, elastic = parts.half_space_H(base, k, co)
+    if base in _HALF_SPACE_H:
+        g, elastic = parts.half_space_H(_HALF_SPACE_H[base], k, co)
         return np.where(parts.elastic, elastic, parts.A * g), parts.CcH * g
-    if base in ("c2_III", "c2_III_n", "c2_shape", "fs_c2", "fsp_c2"):
-        return zero, parts.Ccc * parts.half_space_c(base, k, co)
+    if base in _HALF_SPACE_C:
+        return zero, parts.Ccc * parts.half_space_c(_HALF_SPACE_C[base], k, co)
     if co.has_collapse:
         col = _collapse_basis(parts, base, k)
         if col is not None:
