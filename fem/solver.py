@@ -254,6 +254,26 @@ def update_active_set(active: np.ndarray, lam: np.ndarray, gap: np.ndarray, gap_
     return new, not np.array_equal(new, active)
 
 
+#: a Newton step "restores contact" when its prescribed normal corrections reach this
+#: fraction of its largest component (:func:`restores_contact`)
+RESTORING_STEP = 1e-3
+
+
+def restores_contact(du_c: np.ndarray, du: np.ndarray) -> bool:
+    """The step puts penetrating nodes back on the obstacle: max |du_c| ≥ ``RESTORING_STEP`` ·
+    max |du| (du_c the prescribed normal corrections −g of the active nodes). Such a step is
+    taken whole (:meth:`IndentationSolver._line_search`).
+
+    On a curved obstacle every step that slides active nodes by du_t leaves them off the
+    surface by about κ du_t²/2, so du_c is never exactly zero there (1e-14 … 1e-12 R). Taking
+    every such step whole switched the line search off for rigid spheres: the sphere of
+    R₂ = 0.88 R (Ludwik E/σY 1360, K/σY 1.16, n 0.2) needed 204 increments with 105 rejected
+    to h/R = 0.002, the flat 37 with none; a radius of 10⁶ R, whose gaps round to zero, ran
+    like the flat.
+    """
+    return bool(np.abs(du_c).max(initial=0.0) >= RESTORING_STEP * np.abs(du).max(initial=0.0) > 0.0)
+
+
 def new_active_log() -> dict:
     """Empty bookkeeping of :func:`update_active_set` for one increment."""
     return {"changes": 0, "flips": 0, "frozen": False, "seen": set(), "res": []}
@@ -882,7 +902,7 @@ class IndentationSolver(CycleLegs):
             t4 = time.perf_counter()
             self.timers["linear"] += t4 - t3
             u, known = self._line_search(u, du, free, frames, state, r[free],
-                                         bool(np.any(du_c != 0.0)))
+                                         restores_contact(du_c, du))
             self.timers["line_search"] += time.perf_counter() - t4
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {res_hist[-1]:.2e})")

@@ -219,3 +219,24 @@ def test_an_undone_increment_of_two_bodies_leaves_no_profile_row(monkeypatch):
     assert res.timings["backed_up_increments"] == 1 and res.status == "converged"
     assert np.all(np.diff(res.h) > 0)
     assert len(res.residuals) == res.h.size == res.profile_r.shape[0] == res.profile_p.shape[0]
+
+
+def test_restoring_step_threshold():
+    """Roundoff-sized gap corrections of a curved obstacle do not count as restoring contact."""
+    from spherecontact.fem.solver import restores_contact
+    du = np.array([1e-5, -2e-5, 0.0])
+    assert not restores_contact(np.array([0.0, 1e-14, 0.0]), du)
+    assert restores_contact(np.array([0.0, -1e-6, 0.0]), du)
+    assert not restores_contact(np.zeros(3), np.zeros(3))
+
+
+def test_plastic_sphere_on_rigid_sphere_converges_like_the_flat():
+    """The line search stays on for curved obstacles: a Ludwik sphere (E/σY 1360, K/σY 1.16,
+    n 0.2) pressed by a rigid sphere of 0.88 R to h/R = 0.002 needs no rejected increment and
+    about as many as on the flat (31 against 24 measured); with every step taken whole it
+    needed 72 increments, 29 of them rejected."""
+    mat = Material(E=1360.0, nu=0.3, sigma_y=1.0, K=1.16, n=0.2)
+    flat = IndentationSolver(mat, 1.0).run(0.002).timings
+    sphere = IndentationSolver(mat, 1.0, obstacle=RigidObstacle(0.88)).run(0.002).timings
+    assert flat["rejected_increments"] == 0 and sphere["rejected_increments"] == 0
+    assert sphere["increments"] <= 1.5 * flat["increments"]
