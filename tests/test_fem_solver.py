@@ -240,3 +240,19 @@ def test_plastic_sphere_on_rigid_sphere_converges_like_the_flat():
     sphere = IndentationSolver(mat, 1.0, obstacle=RigidObstacle(0.88)).run(0.002).timings
     assert flat["rejected_increments"] == 0 and sphere["rejected_increments"] == 0
     assert sphere["increments"] <= 1.5 * flat["increments"]
+
+
+def test_smoothness_rerun_of_some_cases_keeps_the_others(tmp_path, monkeypatch):
+    """``--only`` re-measures the chosen cases and keeps every earlier one in the file."""
+    import json
+    from spherecontact.fem import smoothness
+    earlier = [{"label": c[0], "wall_s": 1.0, "scatter_F": 0.01, "edge_band": c[3],
+                "indenter_radius": "inf", "E_over_sigma_y": c[1]} for c in smoothness.CASES]
+    (tmp_path / "smoothness.json").write_text(json.dumps(earlier))
+    monkeypatch.setattr(smoothness, "measure", lambda *a, **k: {"wall_s": 2.0, "scatter_F": 0.02, "n_dofs": 1,
+                                                                "scatter_a": 0.0})
+    monkeypatch.setattr(smoothness, "chart", lambda results, path: None)
+    smoothness.main(["--out", str(tmp_path), "--only", "1"])
+    out = json.loads((tmp_path / "smoothness.json").read_text())
+    assert [r["label"] for r in out] == [c[0] for c in smoothness.CASES]
+    assert [r["wall_s"] for r in out] == [2.0 if i == 1 else 1.0 for i in range(len(out))]
