@@ -283,13 +283,14 @@ def _extra_equal_rows(fig: dict) -> list[str]:
     return rows
 
 
-def _report(fig: dict, png: str, outdir: Path, wall: float) -> None:
+def _report(fig: dict, png: str, outdir: Path, wall: float, reused: int = 0) -> None:
     e, hz, st = fig["equal"], fig["hertz"], fig["stiff"]
+    reuse = f" (--reuse: {reused} stored runs)" if reused else ""
     ok = {k: "pass" if v else "FAIL" for k, v in fig["pass"].items()}
     lines = [
         "# FE verification: two deformable spheres", "",
         f"`python -m spherecontact.fem.verification_pair{' --quick' if fig['quick'] else ''}`, "
-        f"{wall:.0f} s. Figures in `pair_verification.json`.", "",
+        f"{wall:.0f} s{reuse}. Figures in `pair_verification.json`.", "",
         "| check | figure | limit | result |", "|---|---|---|---|",
         f"| equal EPP pair as two bodies (symmetric two-pass penalty {PENALTY:g}) vs one on a flat "
         f"(same penalty, stepping to the pair's approaches), h/R {e['window_h_over_R'][0]:g}–"
@@ -334,6 +335,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     cases = _cases(args.quick)
     runs = saved_runs(outdir, cases, "pair_") if args.reuse else {}
+    reused = len(runs)
     todo = [n for n in cases if n not in runs]
     first = [n for n in todo if "schedule_of" not in cases[n]]  # then the runs that follow them
     for batch in (first, [n for n in todo if n not in first]):
@@ -348,7 +350,7 @@ def main(argv: list[str] | None = None) -> int:
         fig["database_pairs"] = database_pairs(args.db)
         fig["pass"]["plastic_pairs"] = _pairs_pass(fig["database_pairs"])
     (outdir / "pair_verification.json").write_text(json.dumps(fig, indent=2))
-    _report(fig, _plot(runs, outdir), outdir, time.perf_counter() - t0)
+    _report(fig, _plot(runs, outdir), outdir, time.perf_counter() - t0, reused)
     print(json.dumps(fig["pass"]))
     return 0 if all(fig["pass"].values()) else 1
 
