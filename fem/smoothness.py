@@ -145,7 +145,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{label}: scatter F {100 * r['scatter_F']:.2f} %, a {100 * r['scatter_a']:.2f} %, "
               f"{r['wall_s']:.0f} s, {r['n_dofs']} dofs", flush=True)
         (out / "smoothness.json").write_text(json.dumps(results, indent=2) + "\n")
-    (out / "smoothness.json").write_text(json.dumps(results, indent=2) + "\n")  # kept cases after the last run
+    # the kept cases listed after the last re-measured one
+    (out / "smoothness.json").write_text(json.dumps(results, indent=2) + "\n")
     chart(results, out / "smoothness.png")
     return 0
 

@@ -245,6 +245,7 @@ def test_plastic_sphere_on_rigid_sphere_converges_like_the_flat():
 def test_smoothness_rerun_of_some_cases_keeps_the_others(tmp_path, monkeypatch):
     """``--only`` re-measures the chosen cases and keeps every earlier one in the file."""
     import json
+
     from spherecontact.fem import smoothness
     earlier = [{"label": c[0], "wall_s": 1.0, "scatter_F": 0.01, "edge_band": c[3],
                 "indenter_radius": "inf", "E_over_sigma_y": c[1]} for c in smoothness.CASES]
