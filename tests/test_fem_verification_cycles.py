@@ -51,3 +51,18 @@ def test_retrace_at_the_same_approach_needs_no_interpolation():
     run, loading = kinked_cycle(bump=0.002)
     (off,) = retrace_at_same_approach(run, loading)
     assert abs(off["F_max_dev"] - 0.002) < 1e-12
+
+
+def test_small_contact_stiffness_is_judged_per_mesh():
+    """Sneddon's limit is checked on the branches with a/R ≤ 0.05 only, separately per mesh."""
+    from spherecontact.fem.verification_cycles import LIMITS, stiffness_small
+    stiff = [{"mesh": "coarse", "a_over_R": 0.03, "S_over_2Ea": 1.036, "elastic_sphere_dFdh_over_2Ea": 1.013},
+             {"mesh": "coarse", "a_over_R": 0.3, "S_over_2Ea": 1.4, "elastic_sphere_dFdh_over_2Ea": 1.3},
+             {"mesh": "fine", "a_over_R": 0.04, "S_over_2Ea": 0.99, "elastic_sphere_dFdh_over_2Ea": 1.0},
+             {"mesh": "fine", "a_over_R": 0.2, "S_over_2Ea": 1.2, "elastic_sphere_dFdh_over_2Ea": 1.1}]
+    out = stiffness_small(stiff)
+    assert LIMITS["sneddon_small"] == 0.02
+    assert out["coarse"]["branches"] == 1 and not out["coarse"]["within_limit"]
+    assert abs(out["coarse"]["max_dev"] - 0.036) < 1e-12
+    assert out["fine"]["within_limit"] and abs(out["fine"]["max_dev"] - 0.01) < 1e-12
+    assert abs(out["coarse"]["max_dev_from_elastic_sphere"] - (1.036 / 1.013 - 1)) < 1e-12
