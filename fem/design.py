@@ -23,9 +23,9 @@ the format.
 A case the FE cannot finish as designed is replaced in a ``[replace]`` table, by
 its name, with a reason and the parameters that change (``h_max``, ``cycles``)::
 
-    [replace."rsphere4-pp-E3000-nu0.3"]
-    h_max = 0.16
-    reason = "inverted element at h/R 0.174 (Lagrangian mesh at the contact edge)"
+    [replace."two-pp-E300-nu0.3-vs-sy2-c0"]
+    h_max = 0.18
+    reason = "inverted element at h/R 0.186 (Lagrangian mesh at the contact edge)"
 
 The original case leaves the campaign (its stored run becomes superseded) and the
 replacement carries ``replaces`` = (original name, reason) into the reports.
