@@ -7,7 +7,7 @@ equatorial planes, u_r = 0 on the axis. Body 2 is meshed in its own mirrored
 frame (z → −z); the mirror enters only the contact terms.
 
 Contact is frictionless node-to-surface (``segments.py``): the surface nodes
-of the slave body (the smaller sphere; body 1 on a tie) against the C¹
+of the slave body (the softer sphere, :func:`slave_index`) against the C¹
 (Catmull–Rom) curve through the master's surface nodes, with one Lagrange
 multiplier per active slave node and the consistent second derivative of the
 gap, so Newton stays quadratic through large sliding of the interface. No
@@ -60,6 +60,30 @@ from .solver import (
 
 #: |g| of active nodes at convergence, relative to the smaller radius
 GAP_TOL = 1e-12
+
+
+def slave_index(material1: Material, radius1: float, material2: Material, radius2: float,
+                two_pass: bool = False) -> int:
+    """The slave body (0: body 1, 1: body 2) of the node-to-surface contact.
+
+    One pass (exact contact): the softer body — the lower yield stress, then the lower E′,
+    then the smaller sphere, body 1 on a tie. Only the slave's nodes are held on the other
+    surface, so the master's surface nodes between them are free; a master that flows
+    plastically under the contact then has a surface mode of almost no stiffness. Campaign
+    v2's pair R₂/R₁ = 1/3, σY₂/σY₁ = 2 (the smaller sphere harder) had the smaller sphere as
+    slave and Newton failed at h = 0.0169 R₁ whatever the increment (first steps of 4e-4 R₁ on
+    increments of 1e-9, on the soft master's surface inside the contact); with the soft
+    sphere as slave it runs to h = 0.03 R₁ in 51 s, no increment rejected.
+    Two passes (penalty): the smaller sphere, body 1 on a tie (its mesh sets ℓ of k_N).
+    """
+    smaller = 1 if radius2 < radius1 else 0
+    if two_pass:
+        return smaller
+    key1 = (material1.sigma_y, material1.E_prime)
+    key2 = (material2.sigma_y, material2.E_prime)
+    if key1 != key2:
+        return 1 if key2 < key1 else 0
+    return smaller
 
 
 class Kinematics(NamedTuple):
@@ -213,7 +237,7 @@ class ContactPass:
 class TwoBodySolver(CycleLegs):
     """Two elastic–plastic hemispheres on one axis; call ``run(h_max)`` (h = h₁ + h₂).
 
-    Contact: exact (Lagrange multipliers, one pass: slave = the smaller sphere) by
+    Contact: exact (Lagrange multipliers, one pass: slave = the softer sphere) by
     default; with ``options.penalty`` a symmetric two-pass penalty contact (each body's
     nodes against the other's surface, half the stiffness each) with
     k_N = penalty · E*/ℓ, E* the pair's contact modulus and ℓ the length of the pole's
@@ -237,8 +261,8 @@ class TwoBodySolver(CycleLegs):
                        Body(material2, float(radius2), discs[1], discs[0].n_dofs, True)]
         self.n_dofs = sum(b.n_dofs for b in self.bodies)
         self.R = min(radius1, radius2)
-        # the slave is the smaller sphere (finer surface mesh where the contact is)
-        self.slave_index = 1 if radius2 < radius1 else 0
+        self.slave_index = slave_index(material1, radius1, material2, radius2,
+                                       two_pass=self.options.penalty is not None)
         self.slave = self.bodies[self.slave_index]
         self.master = self.bodies[1 - self.slave_index]
         self.k_penalty = None

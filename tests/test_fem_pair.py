@@ -131,3 +131,19 @@ def test_database_pairs_table_and_the_required_pairs():
     assert not _pairs_pass(done[:1])  # one required pair missing
     short = [dict(done[0]), {**done[1], "status": "stopped", "h_end_over_R_min": 0.073}]
     assert not _pairs_pass(short)
+
+
+def test_the_softer_sphere_is_the_slave_of_one_pass_contact():
+    """One pass: the lower yield stress, then the lower E', then the smaller sphere, body 1 on
+    a tie; two passes (penalty) keep the smaller sphere."""
+    from spherecontact.fem.twobody import slave_index
+    soft, hard = Material(E=200.0, nu=0.3, sigma_y=1.0), Material(E=200.0, nu=0.3, sigma_y=2.0)
+    assert slave_index(soft, 1.0, hard, 1 / 3) == 0  # the small hard sphere is the master
+    assert slave_index(hard, 1 / 3, soft, 1.0) == 1
+    assert slave_index(hard, 1.0, hard, 1 / 3) == 1  # same material: the smaller sphere
+    assert slave_index(soft, 1.0, soft, 1.0) == 0
+    stiff = Material(E=600.0, nu=0.3, sigma_y=1.0)
+    assert slave_index(stiff, 1.0, soft, 2.0) == 1  # equal yield stress: the lower E'
+    el1, el2 = Material.elastic(200.0, 0.3), Material.elastic(600.0, 0.2)
+    assert slave_index(el2, 1.0, el1, 2.0) == 1
+    assert slave_index(soft, 1.0, hard, 1 / 3, two_pass=True) == 1
