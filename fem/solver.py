@@ -30,7 +30,7 @@ from .assembly import Discretisation, positive_jacobian
 from .contact import RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
 from .linsolve import ConstrainedPattern, SymmetricSolver
 from .mesh import build_mesh
-from .plasticity import PlasticState, stress_and_tangent, stress_update
+from .plasticity import PlasticState, stress_update, tangent
 from .segment_penalty import SegmentPenalty
 
 #: nodal-force roundoff of the stress update, in units of M R² with M = max(E, 3κ) the
@@ -809,29 +809,33 @@ class IndentationSolver(CycleLegs):
         pairs[nodes] = np.einsum("nab,nb->na", Q, pairs[nodes])
         return out
 
-    def _exact_contact(self, f, data, gap, normal, curv, active, log):
+    def _exact_contact(self, f, gap, normal, active, log):
         """Lagrange-multiplier contact: reactions, active-set update, nodal frames, and the
-        rotated tangent data, residual and prescribed normal displacements of the constrained
-        dofs (the tangent keeps the mesh's sparsity pattern)."""
+        rotated residual and prescribed normal displacements of the constrained dofs."""
         lam = np.einsum("ci,ci->i", self._nodal(f, self.surface), normal)
         changed = False
         if not log["frozen"]:
             active, changed = update_active_set(active, lam, gap, 1e-12 * self.radius, log)
         frames, cdofs = self._frames(active, normal)
-        if frames is not None:
-            idx = np.flatnonzero(active & ~self.on_axis)
-            nodes = self.surface[idx]
-            n = normal[:, idx]
-            tt = np.stack([n[1], -n[0]])
-            blocks = -(lam[idx] * curv[idx])[:, None, None] * np.einsum("ik,jk->kij", tt, tt)
-            data = data.copy()
-            np.add.at(data, self.disc.node_block_slots(nodes, nodes), blocks)
-            data = self.disc.rotate_blocks(data, *frames)
         r = self._rotate(f, frames)
         du_c = np.zeros(self._nd)
         du_c[cdofs] = -gap[active] if self.obstacle.is_flat else np.concatenate(
             [-gap[active & ~self.on_axis], -gap[active & self.on_axis]])
-        return lam, changed, active, frames, cdofs, data, r, du_c
+        return lam, changed, active, frames, cdofs, r, du_c
+
+    def _exact_tangent(self, data, lam, normal, curv, active, frames):
+        """The tangent data of exact contact: the obstacle's curvature term −λκ t tᵀ at the
+        active off-axis nodes, rotated into their nodal frames (the pattern is unchanged)."""
+        if frames is None:
+            return data
+        idx = np.flatnonzero(active & ~self.on_axis)
+        nodes = self.surface[idx]
+        n = normal[:, idx]
+        tt = np.stack([n[1], -n[0]])
+        blocks = -(lam[idx] * curv[idx])[:, None, None] * np.einsum("ik,jk->kij", tt, tt)
+        data = data.copy()
+        np.add.at(data, self.disc.node_block_slots(nodes, nodes), blocks)
+        return self.disc.rotate_blocks(data, *frames)
 
     def _newton(self, u: np.ndarray, h: float, state: PlasticState, active: np.ndarray):
         opt = self.options
@@ -848,19 +852,16 @@ class IndentationSolver(CycleLegs):
                 Fv = disc.deformation_gradient(u)
                 if not positive_jacobian(Fv):
                     raise IncrementFailed("inverted element (J <= 0)")
-                upd, A = stress_and_tangent(Fv, state, mat, elastic=self._elastic)
+                upd = stress_update(Fv, state.cp_inv, state.eps_p, mat, elastic=self._elastic)
                 f = disc.internal_force(upd.P)
             else:
-                Fv, real, f = known
-                upd, A = stress_and_tangent(Fv, state, mat, real=real)
+                Fv, upd, f = known
             t1 = time.perf_counter()
-            data = disc.tangent(A).data
-            t2 = time.perf_counter()
+            # the residual first: the tangent is built only when Newton goes on
             if self.k_penalty is not None:
                 gap, normal, curv, pen, p, fc, points = self._penalty_force(u)
                 changed = not np.array_equal(pen, active)
                 active = pen
-                data = self._penalty_tangent(data.copy(), gap, normal, curv, pen, points)
                 self._points = points
                 r, frames, cdofs = f - fc, None, np.zeros(0, dtype=int)
                 lam = p
@@ -868,8 +869,8 @@ class IndentationSolver(CycleLegs):
                 log["changes"] += changed
             else:
                 gap, normal, curv = self.obstacle.gap_normal(Xs + self._nodal(u, self.surface))
-                lam, changed, active, frames, cdofs, data, r, du_c = self._exact_contact(
-                    f, data, gap, normal, curv, active, log)
+                lam, changed, active, frames, cdofs, r, du_c = self._exact_contact(
+                    f, gap, normal, active, log)
             fixed = np.concatenate([self.fixed_base, cdofs])
             free = np.ones(self._nd, dtype=bool)
             free[fixed] = False
@@ -881,16 +882,28 @@ class IndentationSolver(CycleLegs):
             floor = ROUNDOFF * stiffest_modulus(mat) * R**2 / ref
             res_hist.append(res)
             self._elastic = freeze_toggling(log, upd.dgamma > 0, self._elastic)
-            t3 = time.perf_counter()
+            t2 = time.perf_counter()
             self.timers["constitutive"] += t1 - t0
-            self.timers["assembly"] += t2 - t1
-            self.timers["contact"] += t3 - t2
+            self.timers["contact"] += t2 - t1
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
             if not changed and res <= max(opt.tol, floor) and np.abs(du_c).max(initial=0.0) <= 1e-12 * R:
                 self.plastic_frozen_increments += log.get("plastic_frozen", False)
                 return (u, upd, active, it, log["changes"], res_hist, f, gap, np.where(active, lam, 0.0),
                         normal)
+            A = tangent(Fv, state, mat, upd)
+            t3 = time.perf_counter()
+            data = disc.tangent(A).data
+            t4 = time.perf_counter()
+            if self.k_penalty is not None:
+                data = self._penalty_tangent(data.copy(), gap, normal, curv, active, points)
+            else:
+                data = self._exact_tangent(data, lam, normal, curv, active, frames)
+            t5 = time.perf_counter()
+            self.timers["constitutive"] += t3 - t2
+            self.timers["assembly"] += t4 - t3
+            self.timers["contact"] += t5 - t4
+            t3 = t5
             K = disc.matrix(data)
             rhs = -r - K @ du_c
             scale = float(np.abs(data[self._diag_slots]).mean())
