@@ -903,7 +903,6 @@ class IndentationSolver(CycleLegs):
             self.timers["constitutive"] += t3 - t2
             self.timers["assembly"] += t4 - t3
             self.timers["contact"] += t5 - t4
-            t3 = t5
             K = disc.matrix(data)
             rhs = -r - K @ du_c
             scale = float(np.abs(data[self._diag_slots]).mean())
@@ -912,11 +911,11 @@ class IndentationSolver(CycleLegs):
             du = self.linear.solve_upper(U, diag, rhs, self._upper)
             du[fixed] = du_c[fixed]
             du = self._rotate(du, frames)
-            t4 = time.perf_counter()
-            self.timers["linear"] += t4 - t3
+            t6 = time.perf_counter()
+            self.timers["linear"] += t6 - t5
             u, known = self._line_search(u, du, free, frames, state, r[free],
                                          restores_contact(du_c, du))
-            self.timers["line_search"] += time.perf_counter() - t4
+            self.timers["line_search"] += time.perf_counter() - t6
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {res_hist[-1]:.2e})")
 

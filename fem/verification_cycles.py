@@ -60,9 +60,8 @@ RUNS = {
     "elastic_smooth": (math.inf, 0.3, CYCLES_AT, 1.0, 0.005, 24, 0.03, SMOOTH),
     "E1000_smooth": (1000.0, 0.3, CYCLES_AT, 1.0, 0.005, 24, 0.03, SMOOTH),
 }
-#: the elastic runs whose unloading must retrace their loading, and their mesh
-RETRACE_RUNS = {"elastic": "default mesh", "elastic_band": "edge band 0.03",
-                "elastic_smooth": "edge band 0.03, penalty scaled with the approach"}
+#: the elastic runs whose unloading must retrace their loading
+RETRACE_RUNS = ("elastic", "elastic_band", "elastic_smooth")
 #: (base run, refined run): mesh and increment convergence of the unloading (default mesh: 2× mesh,
 #: half increments; the campaign's band mesh: 2× mesh)
 CONVERGENCE_PAIRS = (("E200", "E200_mesh2"), ("E200", "E200_half_increment"),
@@ -78,12 +77,9 @@ PAIR_RUNS = {
     "pair_elastic_E3": ((600.0, math.inf), 0.01, (0.001, 0.01)),
     "pair_yield3": ((200.0, 3.0), 0.03, (0.01, 0.03)),
 }
-#: the runs of the unloading-stiffness table, and their mesh
-STIFFNESS_RUNS = {"elastic": "default mesh", "E200": "default mesh", "E1000": "default mesh",
-                  "elastic_band": "edge band 0.03", "E200_band": "edge band 0.03",
-                  "E1000_band": "edge band 0.03",
-                  "elastic_smooth": "edge band 0.03, penalty scaled with the approach",
-                  "E1000_smooth": "edge band 0.03, penalty scaled with the approach"}
+#: the runs of the unloading-stiffness table
+STIFFNESS_RUNS = ("elastic", "E200", "E1000", "elastic_band", "E200_band", "E1000_band",
+                  "elastic_smooth", "E1000_smooth")
 LIMITS = {"elastic_retrace": 0.001, "energy": 0.01, "convergence": 0.01, "sneddon_small": 0.02,
           "cycle_cost": 0.20}
 
@@ -211,6 +207,14 @@ def unloading_stiffness(h: np.ndarray, F: np.ndarray) -> float:
     return float(p[1])
 
 
+def mesh_label(name: str) -> str:
+    """The mesh and contact of run ``name`` (:data:`RUNS`) as the report names them."""
+    band, contact = RUNS[name][6], RUNS[name][7:]
+    if not band:
+        return "default mesh"
+    return f"edge band {band:g}" + (", penalty scaled with the approach" if contact else "")
+
+
 def stiffness_small(stiff: list[dict], a_max: float = 0.05) -> dict:
     """Per mesh, the largest |S/(2E*a) − 1| of the unloading branches with a/R ≤ ``a_max``
     (Sneddon's limit of a small contact, limit ``LIMITS["sneddon_small"]``)."""
@@ -262,13 +266,13 @@ def analyse(runs: dict) -> dict:
     E_star = {n: r["E"] / (1 - NU**2) for n, r in runs.items()}
     # 1. elastic retrace and h_res, on each mesh
     out["elastic"] = []
-    for name, mesh in RETRACE_RUNS.items():
+    for name in RETRACE_RUNS:
         if name in runs:
-            out["elastic"] += [{"run": name, "mesh": mesh, **e} for e in retrace(runs[name])]
+            out["elastic"] += [{"run": name, "mesh": mesh_label(name), **e} for e in retrace(runs[name])]
     out["elastic_same_approach"] = []
     for name, source in SCHEDULED_RUNS.items():
         if name in runs and source in runs:
-            out["elastic_same_approach"] += [{"run": source, "mesh": RETRACE_RUNS[source], **e}
+            out["elastic_same_approach"] += [{"run": source, "mesh": mesh_label(source), **e}
                                              for e in retrace_at_same_approach(runs[source], runs[name])]
     el = _arrays(runs["elastic"])
     # 2. unloading stiffness against Sneddon, beside the elastic sphere's own slope
@@ -283,7 +287,7 @@ def analyse(runs: dict) -> dict:
             a = c["a"][unl[0]]
             sneddon = 2.0 * E_star[name] * a
             own = float(np.interp(a, a_el[order], S_el[order])) / (2.0 * E_star["elastic"] * a)
-            stiff.append({"run": name, "mesh": STIFFNESS_RUNS[name], "h_max": hm, "a_over_R": float(a),
+            stiff.append({"run": name, "mesh": mesh_label(name), "h_max": hm, "a_over_R": float(a),
                           "S_over_2Ea": S / sneddon, "elastic_sphere_dFdh_over_2Ea": own})
     out["stiffness"] = stiff
     out["stiffness_small"] = stiffness_small(stiff)
