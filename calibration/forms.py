@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model import levels
-from ..model.coefficients import LITERATURE, SCHEMA_VERSION, Coefficients, CollapseLimit
+from ..model.coefficients import COUNTER_BOUND, LITERATURE, SCHEMA_VERSION, Coefficients, CollapseLimit
 from ..model.single import BodyLaw, curvature_ratio, effective_exponent, flow_log_slope, representative_strain
 from .dataset import Dataset
 
@@ -65,6 +65,7 @@ class Form:
     eps_lo: float = 0.01        # secant of the effective hardening exponent
     eps_hi: float = 0.1
     strain_growth: bool = False  # ε_rep = β x (1 + γ x) with γ fitted (else γ = 0)
+    counter: bool = False       # counter-surface terms exp(q s(a/ρ − a/R)) of H̄_hs, c²_hs (ratio a/R)
 
     # ------------------------------------------------------------------ parameters
     def parameters(self) -> list[tuple[str, float, float, float]]:
@@ -106,7 +107,15 @@ class Form:
                 p += [("offset_c2", 0.0, -3.0, 3.0)]
         if self.strain_growth:
             p += [("beta_growth", 4.0, 0.0, 20.0)]
+        if self.has_counter:
+            p += [("counter_H", 0.0, -COUNTER_BOUND, COUNTER_BOUND),
+                  ("counter_c2", 0.0, -COUNTER_BOUND, COUNTER_BOUND)]
         return p
+
+    @property
+    def has_counter(self) -> bool:
+        """Counter-surface terms: asked for, and the finite-size ratio is a/R (u = a/ρ − a/R)."""
+        return self.counter and self.ratio == "a_over_R"
 
     @functools.cached_property
     def names(self) -> list[str]:
@@ -148,6 +157,8 @@ class Form:
             "collapse": None,
             "references": {},
         }
+        if self.has_counter:
+            d["counter_surface"] = {"H_bar": v["counter_H"], "c2": v["counter_c2"]}
         if self.collapse:
             # ln c²_c = ln c0 + Σ_k d_k (x − X_C2)^(k+1) + n Σ_k e_k (x − X_C2)^(k+1) + ...,
             # expanded in powers of x for the schema (the n e(0) part joins exp_poly[0])
@@ -213,7 +224,9 @@ def _unchecked(d: dict) -> Coefficients:
         collapse_sharpness=0.0 if col is None else col["sharpness"],
         collapse_sharpness_c2=None if col is None else col.get("sharpness_c2"),
         collapse_offset_c2=None if col is None else col.get("offset_c2"),
-        level_II_smooth=lev2["smooth"], beta_growth=d.get("beta_growth", 0.0), source=d["source"],
+        level_II_smooth=lev2["smooth"], beta_growth=d.get("beta_growth", 0.0),
+        counter_H_bar=d.get("counter_surface", {}).get("H_bar", 0.0),
+        counter_c2=d.get("counter_surface", {}).get("c2", 0.0), source=d["source"],
         schema_version=d["schema_version"])
 
 
@@ -276,6 +289,16 @@ def point_inputs(ds: Dataset, co: Coefficients):
     return n_eff, sig, Lam, elastic, y, z
 
 
+def counter_surface_at(ds: Dataset, co: Coefficients) -> np.ndarray:
+    """s(u) of the counter-surface terms at every point (``levels.counter_surface``; u = a/ρ − a/R,
+    0 where the finite-size ratio is a/ρ), memoised."""
+    def make():
+        if co.finite_size_ratio != "a_over_R":
+            return np.zeros(ds.size)
+        return levels.counter_surface(ds.x_rho, ds.x_R)[0]
+    return _memo(ds, "counter_s", (co.finite_size_ratio,), make)
+
+
 def flow_log_slope_at(ds: Dataset, co: Coefficients) -> np.ndarray:
     """m = d ln σ_f/d ln ε_p at every point's ε_rep (0 for elastic bodies), memoised by (β, γ)."""
     def make():
@@ -315,6 +338,11 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     c = _memo(ds, "c2_hs", common + (co.c2_III_prefactor, co.c2_III_exp_poly, co.c2_shape,
                                      co.finite_size_c2, co.fs_c2_plastic),
               lambda: half_space(levels.c2_and_slope, co.finite_size_c2, co.fs_c2_plastic))
+    gH = 1.0
+    if co.has_counter_surface:
+        su = counter_surface_at(ds, co)
+        gH = np.exp(co.counter_H_bar * su)
+        H, c = H * gH, c * np.exp(co.counter_c2 * su)
     if co.has_collapse:
         where = (co.finite_size_ratio, co.eps_lo, co.eps_hi)
         lnHc = _memo(ds, "ln_Hc", (co.collapse_H_bar,) + where,
@@ -326,7 +354,7 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     p = H * np.where(elastic, 1.0, sig)
     if elastic.any():  # elastic bodies: Hertz p_m = 4E'x/(3π) with the finite-size factor
         hertz = 4.0 / (3.0 * math.pi) * ds.E_prime * ds.x_rho * levels.finite_size_factor(
-            y, co.finite_size_H_bar)[0]
+            y, co.finite_size_H_bar)[0] * gH
         p = np.where(elastic, hertz, p)
     return p, c
 
@@ -415,6 +443,13 @@ FORMS: dict[str, Form] = {
                                   n_finite_H=2, n_finite_c=2, finite_by_level=True, n_collapse_H=3,
                                   n_collapse_c=3, n_collapse_nH=2, n_collapse_xnH=2,
                                   n_collapse_xnc=2, strain_growth=True),
+    "smooth2_fs2_xn2n_x2_g_cs": Form("smooth2_fs2_xn2n_x2_g_cs", "as smooth2_fs2_xn2n_x2_g, with "
+                                     "the counter-surface terms of H̄ and c² (a/R_i of a rigid "
+                                     "sphere)", smooth=True, n_shape_H=2, n_shape_c=2,
+                                     n_finite_H=2, n_finite_c=2, finite_by_level=True,
+                                     n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
+                                     n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
+                                     counter=True),
     # the two parts of the xnw weight alone (``--forms``)
     "smooth2_fs2_xnk": Form("smooth2_fs2_xnk", "as smooth2_fs2_xn, c² collapse weight with its own "
                             "sharpness", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
@@ -430,4 +465,4 @@ FORMS: dict[str, Form] = {
 #: collapse limits (calibration/README.md). The steps that led to smooth2_fs2_xn2n_g (smooth2_fs2,
 #: _g, _xn_g, _xn2_g) and the forms they beat stay in FORMS for ``--forms``: cross-validating
 #: every form costs a minute per four forms.
-CANDIDATES = ("seed", "smooth2_fs2_xn2n_g", "smooth2_fs2_xn2n_x2_g", "smooth2_fs2_xn2n_x3_g")
+CANDIDATES = ("seed", "smooth2_fs2_xn2n_g", "smooth2_fs2_xn2n_x2_g", "smooth2_fs2_xn2n_x2_g_cs")

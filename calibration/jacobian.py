@@ -9,7 +9,8 @@ most parameters through a few per-point quantities (``model.levels``):
     ln H̄_c, ln c²_c  linear in every coefficient but the sharpness    collapse limits
     ln H̄ = ln H̄_hs − softplus(k ln r)/k,  ln c² = ln c²_hs + w_c (ln c²_c − ln c²_hs)
 
-with r = H̄_hs/H̄_c, w = σ(k ln r), w_c = σ(k_c (ln r + s_c)). Their derivatives are written
+with r = H̄_hs/H̄_c, w = σ(k ln r), w_c = σ(k_c (ln r + s_c)); the counter-surface terms multiply
+H̄_hs and c²_hs by exp(q s(u)), so ∂ln H̄_hs/∂q_H = ∂ln c²_hs/∂q_c = s(u). Their derivatives are written
 out here, so a column costs a few array operations instead of an evaluation of the model:
 
     ∂ln H̄/∂ln H̄_hs = 1 − w,  ∂ln H̄/∂ln H̄_c = w,  ∂ln H̄/∂ln k = softplus(k ln r)/k − w ln r,
@@ -35,7 +36,7 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import Coefficients
-from .forms import X_C2, flow_log_slope_at, point_inputs
+from .forms import X_C2, counter_surface_at, flow_log_slope_at, point_inputs
 
 __all__ = ["residual_jacobian"]
 
@@ -101,7 +102,10 @@ class _Parts:
         self.smooth = co.level_II_smooth
         self.shape_H = self._shape_sum(co.H_bar_shape)
         self.shape_c = self._shape_sum(co.c2_shape)
+        self.su = counter_surface_at(ds, co)  # s(u) of the counter-surface terms
         H_hs, c_hs = H_q * self.fH, c_q * self.fc
+        if co.has_counter_surface:
+            H_hs, c_hs = H_hs * np.exp(co.counter_H_bar * self.su), c_hs * np.exp(co.counter_c2 * self.su)
         self.pos = pos = (H_hs > 0.0) & ~elastic
         zero = np.zeros_like(H_hs)
         one = np.ones_like(H_hs)
@@ -244,6 +248,11 @@ def _log_derivatives(parts: _Parts, name: str, co: Coefficients):
         dsig = parts.strain(name)
         gH, gc = parts.sH + parts.lfH, parts.sc + parts.lfc
         return dsig * (1.0 - parts.A * gH), -dsig * (parts.CcH * gH + parts.Ccc * gc)
+    if name == "counter_H":  # ln H̄_hs (and the Hertz p_m of elastic points) move by s(u)
+        g = np.where(parts.pos, parts.su, 0.0)
+        return np.where(parts.elastic, parts.su, parts.A * g), parts.CcH * g
+    if name == "counter_c2":
+        return zero, parts.Ccc * parts.su
     if base in _HALF_SPACE_H:
         g, elastic = parts.half_space_H(_HALF_SPACE_H[base], k, co)
         return np.where(parts.elastic, elastic, parts.A * g), parts.CcH * g

@@ -33,7 +33,13 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   H̄ = H̄_hs (1 + r^k)^(−1/k)   (smooth minimum of H̄_hs and H̄_c),
   c² = c²_hs^(1−w_c) · c²_c^(w_c);  H̄_c → ∞ as x → 0 (exponent > 0), so w, w_c → 0 and
   the correction vanishes. L depends on a only through x (n and z are constants of a
-  body and a pair), so p_m keeps rising with 1/ρ and the κ root stays unique.
+  body and a pair), so p_m keeps rising with 1/ρ and the κ root stays unique;
+* counter surface (optional ``counter_surface``, needs the ratio a/R): the half-space
+  H̄_hs and c²_hs are multiplied by exp(q · s(u)) with u = a/ρ − a/R, the contact radius
+  over the radius of the surface pressing the body (a/R_i against a rigid sphere, 0 against
+  a flat and between equal spheres), s(u) = max(u, 0)²/(1 + u²) (C¹, bounded by 1) and
+  q = ``counter_surface.H_bar`` or ``.c2`` in [−2, 2]: the indenter's own curvature at
+  a/R_i of order one, which the parabolic contact geometry of the half-space law leaves out.
 
 Schema 1 files (the literature set) are still read; they have no collapse block.
 
@@ -147,12 +153,36 @@ LITERATURE: dict = {
 
 
 #: top-level keys a set may leave out (``to_dict`` writes them only when they are not the default)
-_OPTIONAL_TOP_KEYS = ("beta_growth", "interface")
+_OPTIONAL_TOP_KEYS = ("beta_growth", "interface", "counter_surface")
+
+#: bound of the counter-surface coefficients: |q| ≤ 2 keeps d ln F/d ln a and d ln h/d ln a
+#: above 2 − |q|/2 ≥ 1 from these terms (ds/d ln u ≤ ½)
+COUNTER_BOUND = 2.0
 
 
 #: allowed ranges of the ``interface`` section's numbers
 _INTERFACE_RANGES = {"coupling": (0.0, 1000.0), "similarity": (0.01, 10.0), "radius": (0.01, 100.0),
                      "exponent": (0.5, 20.0)}
+
+
+def _counter(d: dict) -> dict:
+    """The optional ``counter_surface`` section as ``Coefficients`` fields (absent: none)."""
+    if "counter_surface" not in d:
+        return {}
+    sec = _section(d, "counter_surface")
+    out = {}
+    for key, fld in (("H_bar", "counter_H_bar"), ("c2", "counter_c2")):
+        q = _number(sec, key, "counter_surface.")
+        if not -COUNTER_BOUND <= q <= COUNTER_BOUND:
+            raise ValueError(f"coefficients: 'counter_surface.{key}' must lie in "
+                             f"[{-COUNTER_BOUND:g}, {COUNTER_BOUND:g}], got {q!r}")
+        out[fld] = q
+    fs = d.get("finite_size")
+    if (out["counter_H_bar"] or out["counter_c2"]) and isinstance(fs, dict) \
+            and fs.get("ratio") != "a_over_R":
+        raise ValueError("coefficients: 'counter_surface' needs 'finite_size.ratio' = 'a_over_R' "
+                         f"(u = a/rho - a/R), got {fs.get('ratio')!r}")
+    return out
 
 
 def _interface(d: dict) -> dict:
@@ -364,6 +394,9 @@ class Coefficients:
     collapse_offset_c2: float | None = None     # None: 0
     level_II_smooth: bool = False
     beta_growth: float = 0.0  # γ of ε_rep = β x (1 + γ x); 0: the linear ε_rep = β x
+    #: counter-surface coefficients q of H̄_hs and c²_hs (module docstring; 0: none)
+    counter_H_bar: float = 0.0
+    counter_c2: float = 0.0
     #: two-body interface equation (``unified.py``): coupling λ (0: equal mean pressures alone),
     #: similarity width δ of the fully plastic pressures, and the contact radius a_c/R* and
     #: exponent k of the anchor's move from the Hertz partition to equal strains
@@ -401,6 +434,7 @@ class Coefficients:
         if not 0.0 <= growth <= 100.0:
             raise ValueError(f"coefficients: 'beta_growth' must lie in [0, 100], got {growth!r}")
         interface = _interface(d)
+        counter = _counter(d)
         lam1 = _number(d, "Lambda_I", "")
         lam3 = _number(d, "Lambda_III", "")
         if not 0.0 < lam1 < lam3:
@@ -500,6 +534,7 @@ class Coefficients:
             level_II_smooth=smooth,
             beta_growth=growth,
             **interface,
+            **counter,
             source=source,
             schema_version=version,
             provenance=copy.deepcopy(provenance),
@@ -519,6 +554,8 @@ class Coefficients:
                               "radius": self.interface_radius,
                               "exponent": self.interface_exponent}}
                if self.interface_coupling else {}),
+            **({"counter_surface": {"H_bar": self.counter_H_bar, "c2": self.counter_c2}}
+               if self.has_counter_surface else {}),
             "Lambda_I": self.Lambda_I,
             "Lambda_III": self.Lambda_III,
             "H_bar_III": {"prefactor": self.H_bar_III_prefactor,
@@ -615,6 +652,10 @@ class Coefficients:
         """True when the finite-size coefficients differ between Level I and Level III."""
         return (self.fs_H_bar_plastic != self.finite_size_H_bar
                 or self.fs_c2_plastic != self.finite_size_c2)
+
+    @property
+    def has_counter_surface(self) -> bool:
+        return bool(self.counter_H_bar or self.counter_c2)
 
     @property
     def has_collapse(self) -> bool:

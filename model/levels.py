@@ -44,6 +44,7 @@ __all__ = [
     "c2_and_slope",
     "continue_beyond",
     "finite_size_factor",
+    "counter_surface",
     "level_weight",
     "finite_size_by_level",
     "collapse_blend",
@@ -252,6 +253,20 @@ def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
         H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
         gap = np.where((w > 0.0) | (wc > 0.0), lncc - np.log(c2_hs), 0.0)
         return H, c2_hs * np.exp(wc * gap), w, gap, wc
+
+
+def counter_surface(x, y):
+    """s(u) = max(u, 0)²/(1 + u²) of the counter-surface terms and its slopes d s/d ln x and
+    d s/d ln y (vectorised), with u = x − y = a/ρ − a/R the contact radius over the radius of
+    the surface that presses the body (``coefficients`` module docstring): 0 against a flat
+    and between equal spheres, C¹ at u = 0, bounded by 1 and ds/d ln u ≤ ½, so the factors
+    exp(q s) with |q| ≤ 2 keep F(h) and a(h) increasing for every approach."""
+    x = np.asarray(x, dtype=float)
+    u = x - np.asarray(y, dtype=float)
+    up = np.maximum(u, 0.0)
+    d = 1.0 + u * u
+    ds_du = 2.0 * up / (d * d)
+    return up * up / d, ds_du * x, -ds_du * y
 
 
 def level_weight(Lambda, coeffs: Coefficients):

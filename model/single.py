@@ -45,7 +45,14 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
-from .levels import collapse_blend, finite_size_by_level, level, level_weight, levels_scalar_n
+from .levels import (
+    collapse_blend,
+    counter_surface,
+    finite_size_by_level,
+    level,
+    level_weight,
+    levels_scalar_n,
+)
 from .material import Material
 
 __all__ = [
@@ -246,6 +253,12 @@ class BodyLaw:
         p, c = p * fH, c * fc
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
+        if co.has_counter_surface:  # exp(q s(u)), u = x − y (``levels.counter_surface``)
+            su, su_x, su_y = counter_surface(x, y)
+            qH, qc = co.counter_H_bar, co.counter_c2
+            p, c = p * np.exp(qH * su), c * np.exp(qc * su)
+            dp_x, dp_y = dp_x + qH * su_x, dp_y + qH * su_y
+            dc_x, dc_y = dc_x + qc * su_x, dc_y + qc * su_y
         if co.has_collapse and not math.isinf(mat.sigma_y):
             b = collapse_blend(p / sig, c, y, co, self.n_eff, z)
             w, wc = b.w, b.w_c2

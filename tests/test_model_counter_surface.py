@@ -1,0 +1,154 @@
+"""Counter-surface terms exp(q s(u)) of H̄_hs and c²_hs, u = a/ρ − a/R (``counter_surface``;
+``levels.counter_surface``): the function and its slopes, no effect on flats and equal spheres,
+monotone F(h) far beyond a/R_i = 1, exact slopes of the body law, the schema key, bad values
+named, the calibration form and its Jacobian columns."""
+
+import json
+import math
+import warnings
+
+import numpy as np
+import pytest
+from _slopes import assert_body_log_slopes
+from test_calibration import KNOWN_CO, as_run
+
+from spherecontact.calibration import fit as fitmod
+from spherecontact.calibration.dataset import build_dataset
+from spherecontact.calibration.forms import CANDIDATES, FORMS, predict, predict_exact
+from spherecontact.calibration.jacobian import residual_jacobian
+from spherecontact.calibration.synthetic import model_result
+from spherecontact.model import (
+    CalibrationRangeWarning,
+    Material,
+    Sphere,
+    contact,
+    default_coefficients,
+    levels,
+)
+from spherecontact.model.coefficients import COUNTER_BOUND, LITERATURE, Coefficients
+from spherecontact.model.single import BodyLaw
+
+#: the shipped set without counter-surface terms (the baseline of every comparison here)
+CO = default_coefficients().replace(counter_surface={"H_bar": 0.0, "c2": 0.0})
+LUDWIK = Material(E=500.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)
+FLAT = Sphere(math.inf, Material.rigid())
+
+
+def _with_counter(co: Coefficients, qH: float, qc: float) -> Coefficients:
+    return co.replace(counter_surface={"H_bar": qH, "c2": qc})
+
+
+def test_counter_function_values_slopes_and_bound():
+    x = np.array([0.1, 0.3, 0.5, 1.0, 3.0, 30.0])
+    y = np.array([0.1, 0.2, 0.5, 0.25, 0.5, 1.0])
+    s, sx, sy = levels.counter_surface(x, y)
+    u = x - y
+    np.testing.assert_allclose(s, np.maximum(u, 0) ** 2 / (1 + u * u))
+    assert s[0] == s[2] == 0.0 and np.all(s < 1.0)   # u = 0: nothing; bounded by 1
+    e = 1e-7
+    np.testing.assert_allclose((levels.counter_surface(x * (1 + e), y)[0] - s) / e, sx, atol=1e-6)
+    np.testing.assert_allclose((levels.counter_surface(x, y * (1 + e))[0] - s) / e, sy, atol=1e-6)
+    # ds/d ln u ≤ ½ (the bound that keeps F(h) increasing for |q| ≤ 2)
+    uu = np.geomspace(1e-3, 1e3, 2001)
+    assert np.max(levels.counter_surface(uu, 0.0 * uu)[1]) <= 0.5 + 1e-12
+    # a concave counter-surface (u < 0) is left alone, and the joint at u = 0 is C¹
+    s_neg, sx_neg, _ = levels.counter_surface(np.array([0.1, 0.1 - 1e-9]), np.array([0.2, 0.1]))
+    assert s_neg[0] == 0.0 and abs(sx_neg[1]) < 1e-8
+
+
+def test_flats_and_equal_spheres_are_unchanged():
+    co = _with_counter(CO, -1.5, 1.5)
+    h = np.geomspace(1e-4, 0.3, 9)
+    s1 = Sphere(1.0, LUDWIK)
+    for partner in (FLAT, Sphere(1.0, LUDWIK)):
+        a0, a1 = contact(s1, partner, h, CO), contact(s1, partner, h, co)
+        np.testing.assert_array_equal(a1.F, a0.F)
+        np.testing.assert_array_equal(a1.a, a0.a)
+
+
+def test_a_small_rigid_sphere_feels_them_only_at_large_a_over_Ri():
+    s1, ball = Sphere(1.0, LUDWIK), Sphere(0.25, Material.rigid())
+    co = _with_counter(CO, -0.6, 0.5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        h = np.array([1e-5, 0.1])
+        a0, a1 = contact(s1, ball, h, CO), contact(s1, ball, h, co)
+    small = a0.a[0] / 0.25
+    assert small < 0.05 and abs(a1.F[0] / a0.F[0] - 1) < 10 * small**2
+    # at a/R_i ≈ 0.8: q_H < 0 lowers the mean pressure, q_c > 0 widens the contact at a given h
+    p0, p1 = (st.F[1] / (math.pi * st.a[1] ** 2) for st in (a0, a1))
+    assert a0.a[1] / 0.25 > 0.6 and p1 < 0.9 * p0 and a1.a[1] > 1.03 * a0.a[1]
+
+
+@pytest.mark.parametrize("q", [(-COUNTER_BOUND, COUNTER_BOUND), (COUNTER_BOUND, -COUNTER_BOUND)])
+def test_force_and_radius_rise_far_beyond_the_indenter_radius(q):
+    co = _with_counter(CO, *q)
+    s1, ball = Sphere(1.0, LUDWIK), Sphere(0.1, Material.rigid())
+    h = np.geomspace(1e-5, 0.9, 400)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        st = contact(s1, ball, h, co)
+    assert np.all(np.isfinite(st.F)) and np.all(np.diff(st.F) > 0) and np.all(np.diff(st.a) > 0)
+    assert st.a[-1] / 0.1 > 2.0   # well beyond u = 1
+    assert np.all(st.stiffness > 0)
+
+
+def test_body_log_slopes_stay_exact():
+    law = BodyLaw(LUDWIK, _with_counter(CO, -0.7, 0.9))
+    y = np.geomspace(0.01, 0.8, 29)
+    for ratio in (1.0, 1.5, 5.0):   # u = 0 (flat), u = y/2, u = 4y
+        assert_body_log_slopes(law, ratio * y, y, ratio - 1.0)
+
+
+def test_schema_key_round_trip_and_older_files():
+    d = json.loads(json.dumps(LITERATURE))
+    co = Coefficients.from_dict(d)
+    assert not co.has_counter_surface and "counter_surface" not in co.to_dict()
+    assert not CO.has_counter_surface and "counter_surface" not in CO.to_dict()
+    again = Coefficients.from_dict(_with_counter(CO, -0.25, 0.5).to_dict())
+    assert (again.counter_H_bar, again.counter_c2) == (-0.25, 0.5)
+
+
+@pytest.mark.parametrize("bad, match", [({"H_bar": -2.5, "c2": 0.0}, r"counter_surface\.H_bar"),
+                                        ({"H_bar": 0.0, "c2": math.nan}, r"counter_surface\.c2"),
+                                        ({"H_bar": 0.1}, r"counter_surface\.c2"),
+                                        ({"H_bar": "1", "c2": 0.0}, r"counter_surface\.H_bar")])
+def test_bad_values_are_named(bad, match):
+    d = CO.to_dict()
+    d["counter_surface"] = bad
+    with pytest.raises(ValueError, match=match):
+        Coefficients.from_dict(d)
+
+
+def test_they_need_the_ratio_a_over_R():
+    d = _with_counter(CO, -0.5, 0.5).to_dict()
+    d["finite_size"]["ratio"] = "a_over_rho"
+    with pytest.raises(ValueError, match="a_over_R"):
+        Coefficients.from_dict(d)
+
+
+def test_calibration_form_fits_them_with_exact_jacobian_columns():
+    form = FORMS["smooth2_fs2_xn2n_x2_g_cs"]
+    assert form.name in CANDIDATES
+    assert form.n_params == FORMS["smooth2_fs2_xn2n_x2_g"].n_params + 2
+    assert form.names[-2:] == ["counter_H", "counter_c2"]
+    runs = [(f"sphere-{Ri}", as_run(model_result(LUDWIK, KNOWN_CO, indenter_radius=Ri, n=60)))
+            for Ri in (math.inf, 0.5, 0.25)]
+    ds = build_dataset(runs)
+    assert np.ptp(ds.x_rho - ds.x_R) > 0.5   # the small spheres reach u = a/R_i > 0.5
+    x = form.start()
+    x[-2:] = (-0.6, 0.5)
+    co = form.coefficients(x)
+    p1, c1 = predict(ds, co)
+    p2, c2 = predict_exact(ds, co)
+    np.testing.assert_allclose(p1, p2, rtol=1e-12)
+    np.testing.assert_allclose(c1, c2, rtol=1e-12)
+    res = fitmod.Residuals(form, ds)
+    J = residual_jacobian(res, x)
+    for j in (form.n_params - 2, form.n_params - 1):
+        xj = x.copy()
+        xj[j] += 1e-7
+        np.testing.assert_allclose(J[:, j], (res(xj) - res(x)) / 1e-7, atol=1e-5)
+    # the a/ρ variant of the form has no such terms (u would be 0)
+    from dataclasses import replace
+    assert replace(form, ratio="a_over_rho").n_params == form.n_params - 2
