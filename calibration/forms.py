@@ -450,6 +450,12 @@ FORMS: dict[str, Form] = {
                                      n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
                                      n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
                                      counter=True),
+    "smooth2_fs2_xn2n_x3_g_cs": Form("smooth2_fs2_xn2n_x3_g_cs", "as smooth2_fs2_xn2n_x2_g_cs, both "
+                                     "collapse limits cubic in a/R", smooth=True, n_shape_H=2,
+                                     n_shape_c=2, n_finite_H=2, n_finite_c=2, finite_by_level=True,
+                                     n_collapse_H=3, n_collapse_c=3, n_collapse_nH=2,
+                                     n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
+                                     counter=True),
     # the two parts of the xnw weight alone (``--forms``)
     "smooth2_fs2_xnk": Form("smooth2_fs2_xnk", "as smooth2_fs2_xn, c² collapse weight with its own "
                             "sharpness", smooth=True, n_shape_H=2, n_shape_c=2, n_finite_H=2,
@@ -461,8 +467,9 @@ FORMS: dict[str, Form] = {
                             c2_offset=True),
 }
 #: forms compared by cross-validation in every calibration: the seed's, the form chosen on
-#: campaign v2 before the collapse limits were made quadratic in a/R, and the quadratic and cubic
-#: collapse limits (calibration/README.md). The steps that led to smooth2_fs2_xn2n_g (smooth2_fs2,
-#: _g, _xn_g, _xn2_g) and the forms they beat stay in FORMS for ``--forms``: cross-validating
-#: every form costs a minute per four forms.
+#: campaign v2 before the collapse limits were made quadratic in a/R, the quadratic collapse
+#: limits, and the same with the counter-surface terms (calibration/README.md). The steps that
+#: led to smooth2_fs2_xn2n_g (smooth2_fs2, _g, _xn_g, _xn2_g) and the forms they beat (the cubic
+#: limits with and without the counter-surface terms among them) stay in FORMS for ``--forms``:
+#: cross-validating every form costs a minute per four forms.
 CANDIDATES = ("seed", "smooth2_fs2_xn2n_g", "smooth2_fs2_xn2n_x2_g", "smooth2_fs2_xn2n_x2_g_cs")
