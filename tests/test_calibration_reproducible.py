@@ -116,3 +116,14 @@ def test_database_path_is_written_relative_to_the_working_directory(tmp_path, mo
         assert source_path(spelled) == "data/reference.h5", spelled
     outside = Path(os.path.abspath(os.sep)) / "elsewhere" / "reference.h5"
     assert source_path(outside) == outside.as_posix()
+
+
+def test_shipped_coefficients_name_the_shipped_database():
+    """The shipped file's provenance names the database it was calibrated on: a database
+    committed without recalibrating (on 2026-11-25 a validation pair was re-made after the
+    calibration) leaves a file whose hash no longer matches; ``make calibrate`` rewrites it."""
+    from spherecontact.data import Database
+
+    root = Path(__file__).resolve().parents[1]
+    prov = json.loads((root / "data" / "coefficients.json").read_text())["provenance"]["fe_dataset"]
+    assert prov["content_hash"] == Database(SHIPPED_DB).content_hash
