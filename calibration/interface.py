@@ -89,9 +89,8 @@ def load_pairs(db_path) -> list[PairCurve]:
 
     db = Database(db_path)
     out = []
-    for rec, run in db.runs(set="calibration", status="converged"):
-        if rec.inputs.get("scene") != "two_body":
-            continue
+    two_body = lambda rec: rec.inputs.get("scene") == "two_body"  # noqa: E731
+    for rec, run in db.runs(set="calibration", status="converged", where=two_body):
         c = pair_curve(f"{rec.case} [{rec.key}]", run)
         if c is not None:
             out.append(c)

@@ -242,12 +242,12 @@ def load_runs(db_path, include_stopped: bool = True):
     from spherecontact.data import Database
 
     db = Database(db_path)
-    pairs = db.runs(set="calibration", status="converged")
-    if include_stopped:
-        pairs += db.runs(set="calibration", status="stopped")
-        pairs.sort(key=lambda p: (p[0].case, p[0].key))
     # single-body relations only: a two-body run's h = h1 + h2 includes the partner's share
-    pairs = [p for p in pairs if p[0].inputs.get("scene") != "two_body"]
+    one_body = lambda rec: rec.inputs.get("scene") != "two_body"  # noqa: E731
+    pairs = db.runs(set="calibration", status="converged", where=one_body)
+    if include_stopped:
+        pairs += db.runs(set="calibration", status="stopped", where=one_body)
+        pairs.sort(key=lambda p: (p[0].case, p[0].key))
     if not pairs:
         n_all = len(db.records(set="calibration"))
         raise ValueError(f"{db_path}: no converged calibration runs ({n_all} calibration entries, "

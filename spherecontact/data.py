@@ -34,7 +34,7 @@ import math
 import os
 import re
 import shutil
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -325,14 +325,18 @@ class Database:
         with self._open() as f:
             return self._read(f, rec)
 
-    def runs(self, set: str | None = None, status: str | None = "converged") -> list[tuple[Record, Run]]:
+    def runs(self, set: str | None = None, status: str | None = "converged",
+             where: Callable[[Record], bool] | None = None) -> list[tuple[Record, Run]]:
         """(record, run) pairs sorted by (set, case, key); by default converged runs only.
 
         ``status=None`` returns converged and stopped runs; failed runs have no data.
+        ``where``: a test on the entry (its attributes: scene, materials, …); only the runs
+        that pass it are read.
         """
         if status == "failed":
             raise ValueError("failed runs have no data; use Database.failed()")
-        recs = [r for r in self.records(set=set, status=status) if r.status != "failed"]
+        recs = [r for r in self.records(set=set, status=status)
+                if r.status != "failed" and (where is None or where(r))]
         if not recs:
             return []
         with self._open() as f:

@@ -129,6 +129,19 @@ def test_status_filters_keep_stopped_and_failed_apart(db_path):
         db.runs(status="failed")
 
 
+def test_runs_where_reads_only_the_entries_that_pass(db_path, monkeypatch):
+    db = Database(db_path)
+    read = []
+    original = Database._read
+    monkeypatch.setattr(Database, "_read",
+                        lambda self, f, rec: read.append(rec.key) or original(self, f, rec))
+    e200 = db.runs(status=None, where=lambda r: r.inputs["material"]["E"] == 200.0)
+    assert [r.case for r, _ in e200] == ["flat-pp-E200-nu0.3"] and read == [e200[0][0].key]
+    assert db.runs(where=lambda r: False) == [] and len(read) == 1
+    everything = db.runs(status=None)
+    assert [r.key for r, _ in db.runs(status=None, where=lambda r: True)] == [r.key for r, _ in everything]
+
+
 def test_content_hash_is_deterministic_and_tracks_content(tmp_path, db_path, results):
     a, b, _ = results
     h = Database(db_path).content_hash
