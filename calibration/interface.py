@@ -83,11 +83,12 @@ def pair_curve(name: str, run) -> PairCurve | None:
     return PairCurve(name, s1, s2, h[keep], h1[keep] / h[keep])
 
 
-def load_pairs(db_path) -> list[PairCurve]:
-    """The converged two-body runs of set "calibration" of the database at ``db_path``."""
+def load_pairs(db_path, db=None) -> list[PairCurve]:
+    """The converged two-body runs of set "calibration" of the database at ``db_path`` (``db``:
+    that database already opened, ``spherecontact.data.Database``)."""
     from spherecontact.data import Database
 
-    db = Database(db_path)
+    db = Database(db_path) if db is None else db
     out = []
     two_body = lambda rec: rec.inputs.get("scene") == "two_body"  # noqa: E731
     for rec, run in db.runs(set="calibration", status="converged", where=two_body):

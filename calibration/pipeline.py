@@ -224,7 +224,7 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
                        regimes=regimes)
 
 
-def load_runs(db_path, include_stopped: bool = True):
+def load_runs(db_path, include_stopped: bool = True, db=None):
     """Calibration runs of the database: ``(runs, source)``.
 
     ``runs`` are ``(key, run)`` pairs of set "calibration" with one deformable body (scenes
@@ -236,12 +236,13 @@ def load_runs(db_path, include_stopped: bool = True):
     (:func:`source_path`), content hash, the date of the newest run used (the coefficient
     file's date, so the same database gives the same file), the keys used and those left
     out with their status.
+    ``db``: the database at ``db_path`` already opened (``spherecontact.data.Database``).
     Raises FileNotFoundError/ValueError (from the reader) for a missing or unreadable
     file and ValueError if it holds no usable calibration run.
     """
     from spherecontact.data import Database
 
-    db = Database(db_path)
+    db = Database(db_path) if db is None else db
     # single-body relations only: a two-body run's h = h1 + h2 includes the partner's share
     one_body = lambda rec: rec.inputs.get("scene") != "two_body"  # noqa: E731
     pairs = db.runs(set="calibration", status="converged", where=one_body)
@@ -414,8 +415,11 @@ def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
               candidates=CANDIDATES, workers: int = DEFAULT_WORKERS) -> Calibration:
     """Calibrate from the database at ``db_path``; write the coefficient file and the report."""
     t0 = time.perf_counter()
-    runs, source = load_runs(db_path, include_stopped)
-    pairs = load_pairs(db_path)
+    from spherecontact.data import Database
+
+    db = Database(db_path)  # opened once: listing its entries reads every run's attributes
+    runs, source = load_runs(db_path, include_stopped, db=db)
+    pairs = load_pairs(db_path, db=db)
     source["pairs"] = [c.name for c in pairs]
     read_s = time.perf_counter() - t0
     cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs,
