@@ -245,10 +245,8 @@ def load_runs(db_path, include_stopped: bool = True, db=None):
     db = Database(db_path) if db is None else db
     # single-body relations only: a two-body run's h = h1 + h2 includes the partner's share
     one_body = lambda rec: rec.inputs.get("scene") != "two_body"  # noqa: E731
-    pairs = db.runs(set="calibration", status="converged", where=one_body)
-    if include_stopped:
-        pairs += db.runs(set="calibration", status="stopped", where=one_body)
-        pairs.sort(key=lambda p: (p[0].case, p[0].key))
+    # status None: converged and stopped runs, sorted by (case, key) like every listing
+    pairs = db.runs(set="calibration", status=None if include_stopped else "converged", where=one_body)
     if not pairs:
         n_all = len(db.records(set="calibration"))
         raise ValueError(f"{db_path}: no converged calibration runs ({n_all} calibration entries, "

@@ -6,6 +6,7 @@ named, the calibration form and its Jacobian columns."""
 import json
 import math
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -150,5 +151,4 @@ def test_calibration_form_fits_them_with_exact_jacobian_columns():
         xj[j] += 1e-7
         np.testing.assert_allclose(J[:, j], (res(xj) - res(x)) / 1e-7, atol=1e-5)
     # the a/ρ variant of the form has no such terms (u would be 0)
-    from dataclasses import replace
     assert replace(form, ratio="a_over_rho").n_params == form.n_params - 2
