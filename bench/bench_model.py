@@ -5,6 +5,10 @@ fast path (``ContactLaw`` table: setup time and throughput), and the explicit
 Jackson & Green (2005) formula on the same array as a cost reference.
 Approaches are log-uniform in [1e-6 R, 0.3 R]. Times are the best of ``REPEAT`` runs.
 
+``fast_with_history``: the fast path with a per-contact history (``force(h, h_max)``) for the
+dissimilar pair: every contact loading (h = h_max), every contact on its unloading branch
+(h_max 1–1.3 h), half and half — the DEM case of a packing that loads and unloads.
+
 ``calibrated_range_checks``: cost of the calibrated-range checks (``model/range_check.py``)
 on 1e5 in-range contacts — the fast path's per-evaluation check (one max() against the
 thresholds tabulated at build) against a ``ContactLaw.force`` evaluation, the exact
@@ -104,8 +108,10 @@ def main() -> dict:
     out["exact_equal_pair"] = {"seconds": t_eq, "contacts_per_s": N / t_eq}
     out["exact_dissimilar_pair"] = {"seconds": t_dis, "contacts_per_s": N / t_dis}
 
+    laws = {}
     for name, pair in (("fast_equal_pair", equal), ("fast_dissimilar_pair", dissimilar)):
         setups, law = _setups(pair, co)
+        laws[name] = law
         law.force(h)
         t_fast = _best(lambda law=law: law.force(h))
         out[name] = {
@@ -116,6 +122,15 @@ def main() -> dict:
             "nodes": law.nodes,
             "error_bound": law.error,
         }
+
+    law = laws["fast_dissimilar_pair"]
+    h_up = h * rng.uniform(1.0, 1.3, N)
+    half = np.where(rng.random(N) < 0.5, h, h_up)
+    out["fast_with_history"] = {}
+    for name, hm in (("all_loading", h), ("all_unloading", h_up), ("half_unloading", half)):
+        law.force(h, hm)
+        t = _best(lambda hm=hm: law.force(h, hm))
+        out["fast_with_history"][name] = {"seconds": t, "contacts_per_s": N / t}
 
     # Jackson & Green (2005), steel hemisphere on a rigid flat: the same h array as ω
     Ep = STEEL.E_prime

@@ -83,15 +83,22 @@ def pair_curve(name: str, run) -> PairCurve | None:
     return PairCurve(name, s1, s2, h[keep], h1[keep] / h[keep])
 
 
-def load_pairs(db_path, db=None) -> list[PairCurve]:
+def two_body_runs(db) -> list:
+    """(record, run) of the converged two-body runs of set "calibration" of ``db``."""
+    two_body = lambda rec: rec.inputs.get("scene") == "two_body"  # noqa: E731
+    return db.runs(set="calibration", status="converged", where=two_body)
+
+
+def load_pairs(db_path, db=None, runs=None) -> list[PairCurve]:
     """The converged two-body runs of set "calibration" of the database at ``db_path`` (``db``:
-    that database already opened, ``spherecontact.data.Database``)."""
+    that database already opened, ``spherecontact.data.Database``; ``runs``: those runs
+    already read, :func:`two_body_runs`)."""
     from spherecontact.data import Database
 
-    db = Database(db_path) if db is None else db
+    if runs is None:
+        runs = two_body_runs(Database(db_path) if db is None else db)
     out = []
-    two_body = lambda rec: rec.inputs.get("scene") == "two_body"  # noqa: E731
-    for rec, run in db.runs(set="calibration", status="converged", where=two_body):
+    for rec, run in runs:
         c = pair_curve(f"{rec.case} [{rec.key}]", run)
         if c is not None:
             out.append(c)

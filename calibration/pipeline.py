@@ -22,11 +22,13 @@ import json
 import math
 import os
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from ..cycles import run_cycles
 from ..model.coefficients import Coefficients
 from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
@@ -35,8 +37,9 @@ from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
-from .interface import InterfaceFit, fit_interface, load_pairs
+from .interface import InterfaceFit, fit_interface, load_pairs, two_body_runs
 from .threads import single_threaded_blas
+from .unloading import UnloadingFit, fit_unloading
 from .workers import DEFAULT_WORKERS, Workers
 
 __all__ = ["Calibration", "calibrate_runs", "calibrate", "load_runs", "coefficient_file",
@@ -71,6 +74,9 @@ REFERENCES = {
     "collapse": "Fitted: at large a/R the plastic zone reaches the free surface and the sphere "
                 "flattens as a whole; smooth minimum of the half-space and whole-body hardness "
                 "(model/README.md).",
+    "unloading": "Fitted on the unloading branches of the calibration runs (calibration/unloading.py): "
+                 "Thornton (1997) Hertz-from-the-peak unloading (stiffness 2E*a_max, exponent 3/2) "
+                 "with finite-size stiffening and a peak-dependent exponent (model/unloading.py).",
 }
 
 
@@ -99,6 +105,7 @@ class Calibration:
     breakdown: dict = field(default_factory=dict)  # residuals of the chosen form by band
     regimes: list[RegimeFold] = field(default_factory=list)  # chosen form, one regime held out
     interface: InterfaceFit | None = None  # two-body interface terms (``interface.py``)
+    unloading: UnloadingFit | None = None  # unloading law from the FE cycles (``unloading.py``)
 
     @property
     def best(self) -> FitResult:
@@ -126,13 +133,15 @@ def _warm_start(form: Form, base: FitResult) -> np.ndarray:
 
 def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
                    large_deformation_options: bool = True, source: dict | None = None,
-                   workers: int = DEFAULT_WORKERS, pairs=(), elastic_sphere=()) -> Calibration:
+                   workers: int = DEFAULT_WORKERS, pairs=(), elastic_sphere=(),
+                   cycle_runs=()) -> Calibration:
     """Fit, cross-validate, choose, check. ``runs``: iterable of ``(key, run)``; the
     independent fits run on ``workers`` processes, with one BLAS thread each whatever the
     environment says (the result depends on neither). ``pairs``: two-body runs
     (``interface.PairCurve``) for the interface terms of the chosen form (none: left out);
     ``elastic_sphere``: the FE elastic hemisphere's (h/R, F/Hertz), the Level I anchor of the fits
-    (``fit.level_I_anchor``; none: no anchor)."""
+    (``fit.level_I_anchor``; none: no anchor); ``cycle_runs``: ``(name, run)`` whose unloading
+    cycles give the unloading law (``unloading.py``; none: left out)."""
     t0 = time.perf_counter()
     with single_threaded_blas():  # the result must not depend on the BLAS thread count (threads.py)
         ds = build_dataset(runs, elastic_sphere=elastic_sphere)
@@ -144,6 +153,16 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
         t = time.perf_counter()
         cal.interface = fit_interface(list(pairs), cal.best.coeffs)
         timings["interface_s"] = time.perf_counter() - t
+    if cycle_runs:
+        t = time.perf_counter()
+        co = cal.best.coeffs
+        if cal.interface is not None and cal.interface.coupling > 0.0:
+            co = dataclasses.replace(co, **{f"interface_{k}": v for k, v in cal.interface.section().items()})
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # calibrated-range warnings: these are the calibration runs
+            curves = [c for name, run in cycle_runs for c in run_cycles(name, run, co)]
+        cal.unloading = fit_unloading(curves)
+        timings["unloading_s"] = time.perf_counter() - t
     timings["total_s"] = time.perf_counter() - t0
     return cal
 
@@ -393,6 +412,15 @@ def coefficient_file(cal: Calibration) -> dict:
                       "runs, largest |h1/h model - FE| (calibration/interface.py)",
             "pairs": {name: {"split_max": _stat(e), "split_max_without": _stat(f.errors_none[name])}
                       for name, e in f.errors.items()}}
+    if cal.unloading is not None:
+        u = cal.unloading
+        d["unloading"] = u.section()
+        d["provenance"]["unloading_fit"] = {
+            "method": "least squares of F/F_max along every unloading branch of the calibration runs, "
+                      "peak state from the FE (calibration/unloading.py)",
+            **{k: ({q: (_stat(x) if isinstance(x, float) else x) for q, x in v.items()}
+                  if isinstance(v, dict) else v)
+               for k, v in u.summary().items()}}
     d["references"] = dict(REFERENCES)
     Coefficients.from_dict(d)  # validate before writing
     return d
@@ -417,11 +445,13 @@ def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
 
     db = Database(db_path)  # opened once: listing its entries reads every run's attributes
     runs, source = load_runs(db_path, include_stopped, db=db)
-    pairs = load_pairs(db_path, db=db)
+    two = two_body_runs(db)
+    pairs = load_pairs(db_path, runs=two)
     source["pairs"] = [c.name for c in pairs]
     read_s = time.perf_counter() - t0
     cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs,
-                         elastic_sphere=ELASTIC_SPHERE)
+                         elastic_sphere=ELASTIC_SPHERE,
+                         cycle_runs=runs + [(f"{r.case} [{r.key}]", run) for r, run in two])
     cal.timings["read_s"] = read_s
     if out is not None:
         write_json(out, coefficient_file(cal))

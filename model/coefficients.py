@@ -39,7 +39,10 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   over the radius of the surface pressing the body (a/R_i against a rigid sphere, 0 against
   a flat and between equal spheres), s(u) = max(u, 0)²/(1 + u²) (C¹, bounded by 1) and
   q = ``counter_surface.H_bar`` or ``.c2`` in [−2, 2]: the indenter's own curvature at
-  a/R_i of order one, which the parabolic contact geometry of the half-space law leaves out.
+  a/R_i of order one, which the parabolic contact geometry of the half-space law leaves out;
+* unloading (optional ``unloading``; absent: Thornton 1997, Hertz from the peak): the
+  elastic unloading branch below the largest approach reached, F = F_max ξ^m
+  (``unloading.py`` gives the law; :class:`UnloadingCoefficients` the keys).
 
 Schema 1 files (the literature set) are still read; they have no collapse block.
 
@@ -71,6 +74,7 @@ __all__ = [
     "SCHEMA_VERSION",
     "SUPPORTED_VERSIONS",
     "CollapseLimit",
+    "UnloadingCoefficients",
     "LITERATURE",
     "Coefficients",
     "default_path",
@@ -153,12 +157,44 @@ LITERATURE: dict = {
 
 
 #: top-level keys a set may leave out (``to_dict`` writes them only when they are not the default)
-_OPTIONAL_TOP_KEYS = ("beta_growth", "interface", "counter_surface")
+_OPTIONAL_TOP_KEYS = ("beta_growth", "interface", "counter_surface", "unloading")
 
 #: bound of the counter-surface coefficients: |q| ≤ 2 keeps d ln F/d ln a and d ln h/d ln a
 #: above 2 − |q|/2 ≥ 1 from these terms (ds/d ln u ≤ ½)
 COUNTER_BOUND = 2.0
 
+
+@dataclass(frozen=True)
+class UnloadingCoefficients:
+    """Coefficients of the unloading law (``unloading.py``; JSON section ``unloading``).
+
+    The defaults are Thornton (1997): Hertz from the peak state, i.e. the unloading
+    stiffness 2E*a_max (``stiffness`` 1, no finite-size terms) and the exponent 3/2.
+    """
+
+    #: s₀: unloading stiffness over Sneddon's 2E*a (with the finite-size terms below)
+    stiffness: float = 1.0
+    #: g_a, g_h: each body's stiffness grows by 1 + g_a (a/R_i)² + g_h · 2h_i/R_i
+    size_a: float = 0.0
+    size_h: float = 0.0
+    #: exponent m of a fully plastic peak against a flat: m_p + m_c2 ln c²
+    m_plastic: float = 1.5
+    m_c2: float = 0.0
+    #: ... against a curved counter-surface (u = a|κ| → ∞)
+    m_counter: float = 1.5
+    #: ... of an elastic peak: 3/2 + m_elastic_size ȳ²
+    m_elastic_size: float = 0.0
+    #: k of the elastic weight w = min(λ, 1)^k, λ = p_m over Hertz's at the same a
+    elastic_weight: float = 1.0
+
+    def to_dict(self) -> dict:
+        return {k: getattr(self, k) for k in UNLOADING_RANGES}
+
+
+#: allowed ranges of the ``unloading`` section's numbers (``UnloadingCoefficients``)
+UNLOADING_RANGES = {"stiffness": (0.5, 2.0), "size_a": (0.0, 10.0), "size_h": (0.0, 10.0),
+                    "m_plastic": (1.0, 2.0), "m_c2": (-1.0, 1.0), "m_counter": (1.0, 2.0),
+                    "m_elastic_size": (-1.0, 3.0), "elastic_weight": (0.1, 20.0)}
 
 #: allowed ranges of the ``interface`` section's numbers
 _INTERFACE_RANGES = {"coupling": (0.0, 1000.0), "similarity": (0.01, 10.0), "radius": (0.01, 100.0),
@@ -183,6 +219,25 @@ def _counter(d: dict) -> dict:
         raise ValueError("coefficients: 'counter_surface' needs 'finite_size.ratio' = 'a_over_R' "
                          f"(u = a/rho - a/R), got {fs.get('ratio')!r}")
     return out
+
+
+def _unloading(d: dict) -> dict:
+    """The optional ``unloading`` section as the ``Coefficients.unloading`` field (absent:
+    Thornton's defaults)."""
+    if "unloading" not in d:
+        return {}
+    sec = _section(d, "unloading")
+    values = {}
+    for key, (lo, hi) in UNLOADING_RANGES.items():
+        v = _number(sec, key, "unloading.")
+        if not lo <= v <= hi:
+            raise ValueError(f"coefficients: 'unloading.{key}' must lie in [{lo:g}, {hi:g}], got {v!r}")
+        values[key] = v
+    unknown = sorted(set(sec) - set(UNLOADING_RANGES))
+    if unknown:
+        raise ValueError(f"coefficients: unknown key 'unloading.{unknown[0]}' "
+                         f"(allowed: {', '.join(UNLOADING_RANGES)})")
+    return {"unloading": UnloadingCoefficients(**values)}
 
 
 def _interface(d: dict) -> dict:
@@ -404,6 +459,8 @@ class Coefficients:
     interface_similarity: float = 0.2
     interface_radius: float = 1.0
     interface_exponent: float = 4.0
+    #: unloading law (``unloading.py``); the default is Thornton (1997)
+    unloading: UnloadingCoefficients = field(default_factory=UnloadingCoefficients)
     source: str = "literature"
     schema_version: int = SCHEMA_VERSION
     provenance: dict = field(default_factory=dict, compare=False, hash=False, repr=False)
@@ -435,6 +492,7 @@ class Coefficients:
             raise ValueError(f"coefficients: 'beta_growth' must lie in [0, 100], got {growth!r}")
         interface = _interface(d)
         counter = _counter(d)
+        unloading = _unloading(d)
         lam1 = _number(d, "Lambda_I", "")
         lam3 = _number(d, "Lambda_III", "")
         if not 0.0 < lam1 < lam3:
@@ -535,6 +593,7 @@ class Coefficients:
             beta_growth=growth,
             **interface,
             **counter,
+            **unloading,
             source=source,
             schema_version=version,
             provenance=copy.deepcopy(provenance),
@@ -556,6 +615,8 @@ class Coefficients:
                if self.interface_coupling else {}),
             **({"counter_surface": {"H_bar": self.counter_H_bar, "c2": self.counter_c2}}
                if self.has_counter_surface else {}),
+            **({"unloading": self.unloading.to_dict()}
+               if self.unloading != UnloadingCoefficients() else {}),
             "Lambda_I": self.Lambda_I,
             "Lambda_III": self.Lambda_III,
             "H_bar_III": {"prefactor": self.H_bar_III_prefactor,

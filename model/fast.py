@@ -46,10 +46,11 @@ import time
 import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
-from .contact import ContactState, as_approach
+from .contact import ContactState, as_approach, as_history
 from .range_check import emit, range_check
 from .sphere import Sphere
 from .unified import UnifiedPair, UnifiedState, pair
+from .unloading import peak_parameters
 
 __all__ = ["ContactLaw", "contact_table"]
 
@@ -383,6 +384,7 @@ class ContactLaw:
         self._s = s
         self._inv_ds = 1.0 / ds
         self._cF = _hermite(yF[:-1], yF[1:], dF_r[:-1], dF_l[1:], ds)
+        self._cF_cols = tuple(np.ascontiguousarray(self._cF[:, i]) for i in range(4))
         ya = np.log(st.a)
         self._ca = _hermite(ya[:-1], ya[1:], da_r[:-1], da_l[1:], ds)
         self._cphi = _hermite(phi[:-1], phi[1:], dphi_r[:-1], dphi_l[1:], ds)
@@ -390,6 +392,19 @@ class ContactLaw:
         dy = np.diff(yF)
         al, be = dF_r[:-1] * ds / dy, dF_l[1:] * ds / dy
         self.monotone = bool(np.all(al**2 + be**2 <= 9.0))
+        # unloading branch of a peak at each node (``unloading.py``), interpolated linearly in s:
+        # recovery δ_e/h_max (1: an elastic peak, which unloads along the loading curve), the
+        # exponent m and body 1's residual approach over h_max
+        pk = peak_parameters(self.pair, st)
+        self.unloading_table = {"ln_h": s, "recovery": pk.delta_e / st.h, "m": pk.m,
+                                "h1_res": pk.h1_res / st.h}
+        tab = self.unloading_table  # per interval: value at its start and increment over it
+        self._un = {k: (tab[k][:-1].copy(), np.diff(tab[k])) for k in ("recovery", "m", "h1_res")}
+        # peaks up to the last node of the elastic prefix (recovery 1: Level I) unload along the
+        # loading curve
+        plastic = np.flatnonzero(tab["recovery"] < 1.0)
+        first = plastic[0] if plastic.size else s.size
+        self._h_elastic = float(np.exp(s[first - 1])) if first > 0 else 0.0
         self._build_lookup()
 
     def _build_lookup(self) -> None:
@@ -537,11 +552,22 @@ class ContactLaw:
         j = self._index(s)
         inv = self._inv_ds[j]
         t = (s - self._s[j]) * inv
-        c = self._cF[j]
-        y = c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
-        dy = (c[:, 1] + t * (2.0 * c[:, 2] + 3.0 * t * c[:, 3])) * inv
+        c0, c1, c2, c3 = (col[j] for col in self._cF_cols)  # 1-D gathers: ~10× a row gather
+        y = c3 * t
+        y += c2
+        y *= t
+        y += c1
+        y *= t
+        y += c0
+        dy = c3 * (3.0 * t)
+        dy += 2.0 * c2
+        dy *= t
+        dy += c1
+        dy *= inv
         F = np.exp(y)
-        k = F * dy / h
+        dy *= F
+        dy /= h
+        k = dy
         if not full:
             return F, k
         ca, cp = self._ca[j], self._cphi[j]
@@ -549,11 +575,175 @@ class ContactLaw:
         phi = cp[:, 0] + t * (cp[:, 1] + t * (cp[:, 2] + t * cp[:, 3]))
         return F, k, a, phi * h
 
-    def force(self, h):
+    def _peaks(self, hm):
+        """(F_max, a_max, h1_max, recovery δ_e/h_max, m, h1_res/h_max) of peaks at hm (1-D, > 0):
+        the table inside it, the exact state and law outside."""
+        hm = np.asarray(hm, dtype=float)
+        n = hm.size
+        out = [np.zeros(n) for _ in range(6)]
+        inside = (hm >= self.h_min) & (hm <= self.h_max)
+        if inside.any():
+            x = hm[inside]
+            F, _, a, h1 = self._eval(x, full=True)
+            s = np.log(x)
+            j = self._index(s)
+            t = (s - self._s[j]) * self._inv_ds[j]
+            tab = self.unloading_table
+            vals = [F, a, h1] + [tab[k][j] + t * (tab[k][j + 1] - tab[k][j])
+                                 for k in ("recovery", "m", "h1_res")]
+            for o, v in zip(out, vals, strict=True):
+                o[inside] = v
+        if not inside.all():
+            x = hm[~inside]
+            self.pair.check_approach(x, "h_max")
+            st = self.pair.state_from_h(x)
+            pk = peak_parameters(self.pair, st)
+            vals = [st.F, st.a, st.h1, pk.delta_e / x, pk.m, pk.h1_res / x]
+            for o, v in zip(out, vals, strict=True):
+                o[~inside] = v
+        return out
+
+    def _force_history(self, h, hm):
+        """F and dF/dh with history when every loading contact's h and every plastic peak lie in
+        the table (the hot path: one lookup per contact, at h where it loads or its peak is
+        elastic — back along the loading curve — else at its peak h_max; in place where it saves a
+        pass). Returns None when some contact needs the exact solve."""
+        loading = h >= hm
+        loading |= hm <= self._h_elastic
+        q = np.where(loading, h, hm)               # where the table is read
+        if q.size and (q.min() < self.h_min or q.max() > self.h_max):
+            return None
+        s = np.log(q)
+        j = self._index(s)
+        inv = self._inv_ds[j]
+        t = s
+        t -= self._s[j]
+        t *= inv                                   # position in the interval
+        c0, c1, c2, c3 = (col[j] for col in self._cF_cols)
+        y = c3 * t
+        y += c2
+        y *= t
+        y += c1
+        y *= t
+        y += c0                                    # ln F(q)
+        dy = c3 * (3.0 * t)
+        dy += 2.0 * c2
+        dy *= t
+        dy += c1
+        dy *= inv                                  # d ln F/d ln h at q
+        r0, dr = self._un["recovery"]
+        m0, dm = self._un["m"]
+        delta = dr[j] * t
+        delta += r0[j]
+        delta *= q                                 # δ_e of a peak at q
+        m1 = dm[j] * t
+        m1 += m0[j]
+        m1 -= 1.0                                  # exponent − 1
+        xi = h - q
+        xi /= delta
+        xi += 1.0
+        np.clip(xi, 0.0, 1.0, out=xi)              # ξ (1 where the table is read at h)
+        w = np.maximum(xi, 1e-300)
+        np.log(w, out=w)
+        w *= m1
+        w += y
+        np.exp(w, out=w)
+        w *= xi > 0.0                              # F(q) ξ^(m−1), 0 where ξ = 0
+        F = w * xi
+        dy *= F
+        dy /= q                                    # loading stiffness
+        m1 += 1.0
+        w *= m1
+        w /= delta                                 # unloading stiffness
+        return F, np.where(loading, dy, w)
+
+    def _unload_force(self, h, hm):
+        """F and dF/dh on the unloading branches of peaks at hm > h, all inside the table (the
+        hot path: one lookup, the peak's ln F, linear recovery and exponent, two exponentials)."""
+        s = np.log(hm)
+        j = self._index(s)
+        t = (s - self._s[j]) * self._inv_ds[j]
+        c = self._cF[j]
+        ln_Fmax = c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
+        r0, dr = self._un["recovery"]
+        m0, dm = self._un["m"]
+        rec = r0[j] + t * dr[j]
+        m = m0[j] + t * dm[j]
+        delta = rec * hm
+        xi = (h - hm) / delta + 1.0
+        on = xi > 0.0
+        lx = np.log(np.where(on, xi, 1.0))
+        k = np.exp(ln_Fmax + (m - 1.0) * lx) * on
+        F = k * np.where(on, xi, 0.0)
+        k *= m / delta
+        elastic = rec >= 1.0
+        if elastic.any():  # an elastic peak returns along the loading curve
+            e = elastic & (h > 0.0)
+            F[elastic], k[elastic] = 0.0, 0.0
+            if e.any():
+                F[e], k[e] = self.force(h[e])
+        return F, k
+
+    def _unload(self, h, hm, full: bool = False):
+        """F and dF/dh (and a, h1 if ``full``) on the unloading branches of peaks at hm > h;
+        an elastic peak (recovery 1) returns along the loading curve."""
+        if not full and hm.min() >= self.h_min and hm.max() <= self.h_max:
+            return self._unload_force(h, hm)
+        F_max, a_max, h1_max, rec, m, h1r = self._peaks(hm)
+        delta = rec * hm
+        xi = np.clip((h - hm + delta) / delta, 0.0, 1.0)
+        on = xi > 0.0
+        xm1 = np.where(on, xi ** (m - 1.0), 0.0)
+        F = F_max * xi * xm1
+        k = m * F_max * xm1 / delta
+        a = a_max * xm1
+        h1_res = h1r * hm
+        h1 = np.where(on, h1_res + xi * (h1_max - h1_res), 0.0)
+        elastic = (rec >= 1.0) & (h > 0.0)
+        if elastic.any():
+            if full:
+                st = self(h[elastic])
+                F[elastic], k[elastic], a[elastic], h1[elastic] = st.F, st.stiffness, st.a, st.h1
+            else:
+                F[elastic], k[elastic] = self.force(h[elastic])
+        return (F, k, a, h1) if full else (F, k)
+
+    def force(self, h, h_max=None):
         """Contact force F and stiffness dF/dh for approaches h (any shape; h ≤ 0: zeros).
 
         The hot path for DEM: interpolation for h in [h_min, h_max], exact solve outside.
+        ``h_max``: the largest approach each contact has reached before (scalar or shaped like
+        h; default h, monotone loading): below it the contact is on its unloading/reloading
+        branch (``unloading.py``; F = 0 at and below the residual approach), at or above it on
+        the loading curve. Keep the history with ``np.maximum(h_max, h)`` after each step.
         """
+        if h_max is not None:
+            hh = as_approach(h)
+            hm = as_history(h_max, hh.shape).reshape(-1)
+            flat = hh.reshape(-1)
+            fast = self._force_history(flat, hm)
+            if fast is not None:
+                F, k = fast
+                found = self._table_causes(np.array([flat.max(), hm.max()]) if flat.size else flat)
+                if found:
+                    self._report(found)
+                F, k = F.reshape(hh.shape), k.reshape(hh.shape)
+                return (F[()], k[()]) if hh.ndim == 0 else (F, k)
+            below = flat < hm
+            if not below.any():
+                return self.force(h)
+            if below.all():
+                F, k = self._unload(flat, hm)
+                F, k = F.reshape(hh.shape), k.reshape(hh.shape)
+                return (F[()], k[()]) if hh.ndim == 0 else (F, k)
+            F = np.zeros(flat.shape)
+            k = np.zeros(flat.shape)
+            F[below], k[below] = self._unload(flat[below], hm[below])
+            up = ~below
+            if up.any():
+                F[up], k[up] = self.force(flat[up])
+            F, k = F.reshape(hh.shape), k.reshape(hh.shape)
+            return (F[()], k[()]) if hh.ndim == 0 else (F, k)
         hh = as_approach(h)
         flat = hh.reshape(-1)
         inside = (flat >= self.h_min) & (flat <= self.h_max)
@@ -578,8 +768,11 @@ class ContactLaw:
         F, k = F.reshape(hh.shape), k.reshape(hh.shape)
         return (F[()], k[()]) if hh.ndim == 0 else (F, k)
 
-    def __call__(self, h) -> ContactState:
-        """Full state (F, a, h1, h2, stiffness; p_m, κ, ρ_i) shaped like h."""
+    def __call__(self, h, h_max=None) -> ContactState:
+        """Full state (F, a, h1, h2, stiffness; p_m, κ, ρ_i) shaped like h; ``h_max`` as in
+        :meth:`force` (on an unloading branch κ and ρ_i are the peak's)."""
+        if h_max is not None:
+            return self._state_with_history(h, h_max)
         hh = as_approach(h)
         flat = hh.reshape(-1)
         n = flat.size
@@ -604,6 +797,27 @@ class ContactLaw:
             found = self._exact_causes(st, found)
         if found:
             self._report(found)
+        shaped = {f: v.reshape(hh.shape) for f, v in out.items()}
+        return ContactState(**{f: (v[()] if hh.ndim == 0 else v) for f, v in shaped.items()})
+
+    def _state_with_history(self, h, h_max) -> ContactState:
+        hh = as_approach(h)
+        hm = as_history(h_max, hh.shape).reshape(-1)
+        flat = hh.reshape(-1)
+        below = flat < hm
+        st = self(np.where(below, 0.0, flat))  # loading points (zeros where below)
+        out = {f: np.array(getattr(st, f), dtype=float).reshape(-1) for f in ContactState._fields}
+        if below.any():
+            x, xm = flat[below], hm[below]
+            F, k, a, h1 = self._unload(x, xm, full=True)
+            on = F > 0.0
+            peak = self(xm)
+            for f, v in (("F", F), ("stiffness", k), ("a", a), ("h1", h1), ("h2", np.where(on, x - h1, 0.0))):
+                out[f][below] = v
+            with np.errstate(invalid="ignore", divide="ignore"):
+                out["p_m"][below] = np.where(on, F / (math.pi * a * a), 0.0)
+            for f in ("kappa", "rho1", "rho2"):
+                out[f][below] = np.where(on, getattr(peak, f), 0.0 if f == "kappa" else np.inf)
         shaped = {f: v.reshape(hh.shape) for f, v in out.items()}
         return ContactState(**{f: (v[()] if hh.ndim == 0 else v) for f, v in shaped.items()})
 

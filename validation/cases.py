@@ -65,6 +65,7 @@ class Case:
     reason: str = ""
     wall_s: float = math.nan
     provenance: dict = field(default_factory=dict)
+    cycles: dict = field(default_factory=dict)  # per unloading branch (``fem.io`` ``cycles/*``)
 
     @property
     def label(self) -> str:
@@ -208,7 +209,8 @@ def case_from_run(run, key: str = "", set: str = "", name: str = "", params: dic
                 curves={k: np.asarray(v, dtype=float) for k, v in run.curves.items()},
                 status=run.status if status is None else status,
                 reason=run.reason if reason is None else reason,
-                wall_s=_wall(wall_s, prov), provenance=prov)
+                wall_s=_wall(wall_s, prov), provenance=prov,
+                cycles={k: np.asarray(v) for k, v in (getattr(run, "cycles", None) or {}).items()})
 
 
 def load_cases(db_path, set_name: str, statuses=("converged", "stopped")) -> list[Case]:

@@ -12,6 +12,10 @@ Keys (all optional; defaults below)::
     [model]                     # acceptance: largest |relative error| in the window
     F_max = 0.05
     a_max = 0.05
+
+    [unloading]                 # acceptance of the unloading law given the FE's peak
+    F_branch_max = 0.03         # largest |ΔF|/F_max along each unloading branch
+    h_res_max = 0.03            # |Δh_res|/h_max
 """
 
 from __future__ import annotations
@@ -32,10 +36,12 @@ class Thresholds:
     a_min_over_R: float = 0.01
     F_max: float = 0.05
     a_max: float = 0.05
+    F_branch_max: float = 0.03
+    h_res_max: float = 0.03
 
     def __post_init__(self) -> None:
         for name in ("h_over_R_max", "h_over_R_large_max", "large_deformation_from", "a_min_over_R",
-                     "F_max", "a_max"):
+                     "F_max", "a_max", "F_branch_max", "h_res_max"):
             v = getattr(self, name)
             if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
                 raise ValueError(f"threshold {name} must be a finite number > 0, got {v!r}")
@@ -44,7 +50,7 @@ class Thresholds:
 
 
 _KEYS = {"window": ("h_over_R_max", "h_over_R_large_max", "large_deformation_from", "a_min_over_R"),
-         "model": ("F_max", "a_max")}
+         "model": ("F_max", "a_max"), "unloading": ("F_branch_max", "h_res_max")}
 
 
 def load_thresholds(path=None) -> Thresholds:

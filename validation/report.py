@@ -24,6 +24,8 @@ from .stability import (
 )
 from .studies import mdr_points, reference, speed_accuracy, speed_accuracy_chart, speed_accuracy_table
 from .tables import class_matrix, class_tables, failures, level_table, pct, run_table
+from .unloading import unloading_failures, unloading_rows
+from .unloading_report import unloading_section
 
 __all__ = ["ReportResult", "build_report", "worst_point"]
 
@@ -96,6 +98,8 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
     cf = default_coefficients() if coeffs is None else coeffs
     comps = [compare_case(c, coeffs, th, mdr) for c in validation if c.h.size >= 2]
     fails = failures(comps, th)
+    unload = unloading_rows(validation, coeffs)
+    unload_fails = unloading_failures(unload, th.F_branch_max, th.h_res_max)
     pngs: list[Path] = []
     md = _header(source, cf, coeff_path, th, th_path, validation, studies, skipped or [])
     if studies_source:
@@ -121,6 +125,11 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
                       f"{worst_point(c, 'a')}.")
     else:
         md.append(f"**PASS** — all {len(comps)} runs within the thresholds.")
+    if unload:
+        md += ["", (f"**FAIL (unloading)** — {len(unload_fails)} of {len(unload)} unloading branches "
+                    "exceed the thresholds `[unloading]` (section \"Unloading and reloading\")."
+                    if unload_fails else
+                    f"**PASS (unloading)** — all {len(unload)} unloading branches within the thresholds.")]
     stopped = [c for c in comps if c.case.status != "converged"]
     if stopped:
         md += ["", "Runs that stopped early are checked over the part the FE reached: "
@@ -168,6 +177,11 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
     lines, mdr_pngs = mdr_section(comps, mdr, out, coeffs=coeffs, source=mdr_source)
     md += lines
     pngs += mdr_pngs
+
+    # ------------------------------------------------------------------ unloading
+    lines, unload_pngs = unloading_section(unload, th.F_branch_max, th.h_res_max, out)
+    md += lines
+    pngs += unload_pngs
 
     # ------------------------------------------------------------------ speed–accuracy
     md += ["## Speed and accuracy", ""]
@@ -227,7 +241,7 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            "curves) and where a law does not apply.", ""]
     path = out / "index.md"
     path.write_text("\n".join(md))
-    return ReportResult(path, comps, fails, pngs)
+    return ReportResult(path, comps, fails + [f"unloading: {f}" for f in unload_fails], pngs)
 
 
 def _probe_summary(probes) -> str:

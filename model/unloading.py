@@ -1,0 +1,180 @@
+"""Unloading and reloading below the largest approach reached: the elastic branch.
+
+Below the largest approach h_max reached, two elastic–plastic spheres unload and reload
+elastically along one branch (the FE's reloading retraces its unloading to 0.01 % of F_max)
+from the peak state (h_max, F_max, a_max) down to the residual approach h_res, where the
+force vanishes; beyond h_max they follow the loading curve again. With ξ = (h − h_res)/δ_e,
+δ_e = h_max − h_res the elastic recovery,
+
+    F = F_max ξ^m,   dF/dh = m F/(ξ δ_e),   a = a_max ξ^(m−1)
+
+(a from Sneddon's dF/dh = 2E*a along the branch). Thornton (1997) takes Hertz from the
+peak state: m = 3/2 and δ_e = 3F_max/(4E* a_max) — the default coefficients. The FE
+cycles of campaign v2 show where that is off: the unloading stiffness S = m F_max/δ_e
+reaches 2.0–2.2 × 2E*a_max at h/R = 0.3 (a flattened sphere is a squat body, stiffer than a
+half-space), and m falls from 3/2 (an elastic peak) to 1.2–1.45 (a plastic one: a flattened,
+more conforming residual profile). The law here (``UnloadingCoefficients``):
+
+* each deformable body i has the compliance C_i = c_i/(2a g_i), c_i = (1 − ν_i²)/E_i,
+  g_i = 1 + g_a (a/R_i)² + g_h · 2h_i/R_i (its contact radius and its own approach at the
+  peak over its radius); δ_e = m F_max C/s₀ with C = Σ C_i;
+* m = (1 − w)[(1 − U)(m_p + m_c2 ln c²) + U m_counter] + w (3/2 + m_el ȳ²), clipped to
+  [1, 3], with the elastic weight w = min(λ, 1)^k, λ = p_m/p_Hertz(a) = 3πR* p_m/(4E*a) (1 at
+  an elastic peak, → 0 as the pressure flattens), c² = a²/(2R*h) of the peak, U = u/(1 + u),
+  u = a|κ| the curvature of the contact surface (0 on a flat and between equal spheres,
+  a/R_i against a rigid sphere) and ȳ = Σ c_i (a/R_i)/Σ c_i;
+* h_res = r · max(h_max − δ_e, 0), r = min(1, s/s_on) with s the larger level weight of the
+  two bodies at the peak (0 in Level I) and s_on = ``ONSET``: an elastic peak leaves no
+  residual approach. Such a peak unloads along the loading curve itself (no hysteresis;
+  :func:`elastic_peak`);
+* each body's residual approach (its share of the residual dent): h_res,i ∝ max(h_i −
+  δ_e C_i/C, 0), scaled so that they add up to h_res.
+
+Derived: the work returned by unloading F_max δ_e/(m + 1), the dissipated work and the
+coefficient of restitution of a quasi-static impact (``cycle.py``).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from .coefficients import UnloadingCoefficients
+from .levels import level_weight
+from .unified import UnifiedPair, UnifiedState
+
+__all__ = ["ONSET", "EXPONENT_RANGE", "Peak", "PeakFeatures", "features", "peak_features",
+           "unloading_law", "peak_parameters", "elastic_peak", "branch", "work_returned"]
+
+#: level weight over which the residual approach grows from 0 to the law's value: a peak in
+#: Level I (weight 0) leaves none; FE cycles at weights 1e-4 / 1e-3 / 4e-3 left 0 / 4 / 3 % of h_max
+ONSET = 1e-3
+#: the unloading exponent is kept in this range (F stays increasing and C¹ at h_res)
+EXPONENT_RANGE = (1.0, 3.0)
+
+
+class Peak(NamedTuple):
+    """Unloading parameters at the largest approach reached (arrays of one shape)."""
+
+    h_max: np.ndarray
+    F_max: np.ndarray
+    a_max: np.ndarray
+    m: np.ndarray        # exponent of F = F_max ξ^m
+    delta_e: np.ndarray  # elastic recovery h_max − h_res
+    h_res: np.ndarray    # residual approach (F = 0 at and below it)
+    h1_max: np.ndarray   # approaches of each body at the peak
+    h2_max: np.ndarray
+    h1_res: np.ndarray   # residual approach of each body (its share of the residual dent)
+    h2_res: np.ndarray
+    plastic: np.ndarray  # bool: the peak left the elastic Level I (False: no hysteresis)
+
+
+class PeakFeatures(NamedTuple):
+    """What the law reads from a loaded state (n peaks; body columns 0, 1; a rigid body has
+    compliance 0). Built by :func:`peak_features` from the model, by calibration from the FE."""
+
+    h: np.ndarray           # (n,) approach at the peak
+    F: np.ndarray           # (n,) force
+    a: np.ndarray           # (n,) contact radius
+    h_i: np.ndarray         # (n, 2) each body's approach
+    compliance: np.ndarray  # (n, 2) c_i = 1/E'_i
+    y: np.ndarray           # (n, 2) a/R_i (0 for a flat)
+    z: np.ndarray           # (n, 2) 2h_i/R_i
+    lam: np.ndarray         # (n,) λ = 3πR* p_m/(4E* a), at most 1
+    U: np.ndarray           # (n,) u/(1 + u), u = a|κ|
+    log_c2: np.ndarray      # (n,) ln(a²/(2R* h))
+    onset: np.ndarray       # (n,) r = min(1, s/ONSET), s the larger level weight
+
+
+def features(h, F, a, h_i, compliance, radius, kappa, R_star: float, level_weight_max) -> PeakFeatures:
+    """:class:`PeakFeatures` from the peak values (arrays; ``h_i``, ``compliance``, ``radius``
+    with a last axis of 2, one column per body; radius inf for a flat)."""
+    h, F, a = (np.asarray(v, dtype=float) for v in (h, F, a))
+    h_i = np.asarray(h_i, dtype=float)
+    c = np.broadcast_to(np.asarray(compliance, dtype=float), h_i.shape)
+    R = np.broadcast_to(np.asarray(radius, dtype=float), h_i.shape)
+    y = a[:, None] / R
+    z = 2.0 * h_i / R
+    p_m = F / (math.pi * a * a)
+    lam = np.minimum(3.0 * math.pi * R_star * p_m * c.sum(axis=1) / (4.0 * a), 1.0)
+    u = a * np.abs(np.asarray(kappa, dtype=float))
+    return PeakFeatures(h=h, F=F, a=a, h_i=h_i, compliance=c, y=y, z=z, lam=lam, U=u / (1.0 + u),
+                        log_c2=np.log(a * a / (2.0 * R_star * h)),
+                        onset=np.minimum(np.asarray(level_weight_max, dtype=float) / ONSET, 1.0))
+
+
+def peak_features(p: UnifiedPair, st: UnifiedState) -> PeakFeatures:
+    """:class:`PeakFeatures` of the model's loaded states ``st`` of the pair ``p``."""
+    comp, radius, s_max = [], [], np.zeros_like(st.a)
+    for s, Lam in ((p.s1, st.Lambda1), (p.s2, st.Lambda2)):
+        comp.append(0.0 if s.is_rigid else 1.0 / s.material.E_prime)
+        radius.append(s.radius)
+        if not s.is_rigid and math.isfinite(s.material.sigma_y):
+            s_max = np.maximum(s_max, level_weight(np.maximum(Lam, 0.0), p.coeffs)[0])
+    return features(st.h, st.F, st.a, np.stack([st.h1, st.h2], axis=1), comp, radius, st.kappa,
+                    p.R_star, s_max)
+
+
+def unloading_law(f: PeakFeatures, co: UnloadingCoefficients):
+    """The law of the module docstring: (m, δ_e, h_res, h_res,1) for the peaks ``f``."""
+    c = f.compliance
+    Ci = c / (2.0 * f.a[:, None] * (1.0 + co.size_a * f.y**2 + co.size_h * f.z))
+    C = Ci.sum(axis=1)
+    y_bar = (c * f.y).sum(axis=1) / c.sum(axis=1)
+    w = f.lam ** co.elastic_weight
+    m_p = (1.0 - f.U) * (co.m_plastic + co.m_c2 * f.log_c2) + f.U * co.m_counter
+    m = np.clip((1.0 - w) * m_p + w * (1.5 + co.m_elastic_size * y_bar**2), *EXPONENT_RANGE)
+    delta = m * f.F * C / co.stiffness
+    h_res = f.onset * np.maximum(f.h - delta, 0.0)
+    delta_e = f.h - h_res
+    share = np.maximum(f.h_i - delta_e[:, None] * Ci / C[:, None], 0.0)
+    total = share.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        h1_res = np.where(total > 0.0, h_res * share[:, 0] / total, 0.0)
+    return m, delta_e, h_res, h1_res
+
+
+def peak_parameters(p: UnifiedPair, st: UnifiedState, law: UnloadingCoefficients | None = None) -> Peak:
+    """The unloading parameters of the loaded states ``st`` (the largest approaches reached)
+    of the pair ``p`` (module docstring); ``law`` defaults to the pair's coefficients'."""
+    f = peak_features(p, st)
+    m, delta_e, h_res, h1_res = unloading_law(f, p.coeffs.unloading if law is None else law)
+    return Peak(h_max=st.h, F_max=st.F, a_max=st.a, m=m, delta_e=delta_e, h_res=h_res,
+                h1_max=st.h1, h2_max=st.h2, h1_res=h1_res, h2_res=h_res - h1_res,
+                plastic=f.onset > 0.0)
+
+
+def elastic_peak(pk: Peak) -> np.ndarray:
+    """True where the peak stayed in Level I: the branch is the loading curve itself."""
+    return ~pk.plastic
+
+
+class Branch(NamedTuple):
+    F: np.ndarray
+    stiffness: np.ndarray
+    a: np.ndarray
+    h1: np.ndarray
+    h2: np.ndarray
+
+
+def branch(h, pk: Peak) -> Branch:
+    """F, dF/dh, a and each body's approach on the unloading branch of ``pk`` at approaches h
+    (h ≤ h_max; below h_res: zeros)."""
+    h = np.asarray(h, dtype=float)
+    xi = np.clip((h - pk.h_res) / pk.delta_e, 0.0, 1.0)
+    on = xi > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xm1 = np.where(on, xi ** (pk.m - 1.0), 0.0)
+    F = pk.F_max * xi * xm1
+    k = pk.m * pk.F_max * xm1 / pk.delta_e
+    a = pk.a_max * xm1
+    h1 = np.where(on, pk.h1_res + xi * (pk.h1_max - pk.h1_res), 0.0)
+    h2 = np.where(on, pk.h2_res + xi * (pk.h2_max - pk.h2_res), 0.0)
+    return Branch(F=F, stiffness=k, a=a, h1=h1, h2=h2)
+
+
+def work_returned(pk: Peak) -> np.ndarray:
+    """Work returned by the unloading from h_max to h_res: ∫F dh = F_max δ_e/(m + 1)."""
+    return pk.F_max * pk.delta_e / (pk.m + 1.0)

@@ -1,0 +1,117 @@
+"""FE unloading cycles as the unloading law sees them (``model/unloading.py``).
+
+A run with cycles (``fem.io``: ``cycles/*``, ``curves/branch``) holds per unloading branch
+its peak (h_max, F_max, a_max; the increments of the peak and of the end) and the branch
+F(h) down to the residual approach h_res. :func:`run_cycles` turns each into an
+:class:`UnloadingCurve`: the branch as F/F_max at the FE's approaches and the peak as the
+law's ``PeakFeatures`` — F, a, each body's approach h_i and the curvature κ of the contact
+surface from the FE; only the level weight of the onset ramp comes from the model (the
+loading coefficients' Λ at the FE's a_max). Calibration fits the law to these; validation
+scores it on them (:func:`branch_errors`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .fem.io import spheres_from_inputs
+from .model.coefficients import Coefficients, UnloadingCoefficients
+from .model.levels import level_weight
+from .model.unified import pair
+from .model.unloading import PeakFeatures, features, unloading_law
+
+__all__ = ["UnloadingCurve", "run_cycles", "branch_errors", "law_residuals", "joined"]
+
+#: FE scenes of the runs → the model's scene (``fem.io.spheres_from_inputs``)
+_SCENES = {"rigid_flat": "flat", "rigid_sphere": "rigid_sphere", "two_body": "two_body",
+           "equal_pair_symmetry": "flat"}
+
+
+@dataclass(frozen=True)
+class UnloadingCurve:
+    """One FE unloading branch and its peak."""
+
+    name: str               # run name and cycle number
+    h: np.ndarray           # approaches of the branch, from h_max down to h_res
+    f: np.ndarray           # F/F_max there
+    h_max: float
+    h_res: float            # the FE's residual approach
+    R: float                # the smaller deformable radius (for h/R)
+    peak: PeakFeatures = field(repr=False)  # one peak
+
+
+def _peak_values(run, scene: str, i: int):
+    """(h_i pair, |κ|) of the FE at increment ``i``."""
+    c = run.curves
+    h = float(c["h"][i])
+    if scene == "two_body":
+        return (float(c["h1"][i]), float(c["h2"][i])), abs(float(c["interface_curvature"][i]))
+    if scene == "equal_pair_symmetry":
+        return (0.5 * h, 0.5 * h), 0.0
+    R_i = float(run.inputs.get("indenter_radius", math.inf)) if scene == "rigid_sphere" else math.inf
+    return (h, 0.0), 1.0 / R_i
+
+
+def run_cycles(name: str, run, coeffs: Coefficients) -> list[UnloadingCurve]:
+    """The unloading branches of one FE run (``fem.io.Run``; none without cycles)."""
+    cyc = getattr(run, "cycles", None) or {}
+    if "h_max" not in cyc or len(cyc["h_max"]) == 0:
+        return []
+    scene = str(run.inputs.get("scene", "rigid_flat"))
+    s1, s2 = spheres_from_inputs(run.inputs, _SCENES.get(scene, "flat"))
+    if scene == "equal_pair_symmetry":
+        s2 = s1
+    p = pair(s1, s2, coeffs)
+    comp = [0.0 if s.is_rigid else 1.0 / s.material.E_prime for s in (s1, s2)]
+    radius = [s.radius for s in (s1, s2)]
+    R = min(s.radius for s in (s1, s2) if not s.is_rigid)
+    h, F = np.asarray(run.curves["h"], dtype=float), np.asarray(run.curves["F"], dtype=float)
+    a_max = np.asarray(cyc["a_max"], dtype=float)
+    st = p.state_at_a(a_max)
+    weight = np.zeros_like(a_max)
+    for s, Lam in ((s1, st.Lambda1), (s2, st.Lambda2)):
+        if not s.is_rigid and math.isfinite(s.material.sigma_y):
+            weight = np.maximum(weight, level_weight(np.maximum(Lam, 0.0), coeffs)[0])
+    out = []
+    for k in range(len(a_max)):
+        i0, i1 = int(cyc["increment_peak"][k]), int(cyc["increment_end"][k])
+        hm, Fm = float(cyc["h_max"][k]), float(cyc["F_max"][k])
+        h_i, kappa = _peak_values(run, scene, i0)
+        pk = features([hm], [Fm], [a_max[k]], [h_i], comp, radius, [kappa], p.R_star, [weight[k]])
+        out.append(UnloadingCurve(name=f"{name} cycle {k + 1}", h=h[i0:i1 + 1], f=F[i0:i1 + 1] / Fm,
+                                  h_max=hm, h_res=float(cyc["h_res"][k]), R=R, peak=pk))
+    return out
+
+
+def joined(curves) -> tuple[PeakFeatures, np.ndarray]:
+    """The peaks of ``curves`` as one batch, and the curve index of every branch point."""
+    peaks = PeakFeatures(*(np.concatenate([getattr(c.peak, f) for c in curves])
+                           for f in PeakFeatures._fields))
+    idx = np.concatenate([np.full(c.h.size, i) for i, c in enumerate(curves)])
+    return peaks, idx
+
+
+def law_residuals(law: UnloadingCoefficients, peaks: PeakFeatures, idx, h, f):
+    m, delta_e, h_res, _ = unloading_law(peaks, law)
+    xi = np.clip((h - h_res[idx]) / delta_e[idx], 0.0, 1.0)
+    return xi ** m[idx] - f, h_res
+
+
+def branch_errors(law: UnloadingCoefficients, curves) -> tuple[np.ndarray, np.ndarray]:
+    """Per curve: the largest |F_law − F_FE|/F_max along the branch and |h_res,law − h_res,FE|/h_max."""
+    if not curves:
+        return np.zeros(0), np.zeros(0)
+    peaks, idx = joined(curves)
+    h = np.concatenate([c.h for c in curves])
+    f = np.concatenate([c.f for c in curves])
+    r, h_res = law_residuals(law, peaks, idx, h, f)
+    worst = np.zeros(len(curves))
+    np.maximum.at(worst, idx, np.abs(r))
+    fe = np.array([c.h_res for c in curves])
+    hm = np.array([c.h_max for c in curves])
+    return worst, np.abs(h_res - fe) / hm
+
+
