@@ -325,6 +325,8 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
         for name, e in f.errors.items():
             L.append(f"| {name} | {100 * f.errors_none[name]:.1f} | {100 * e:.1f} |")
         L.append("")
+    if cal.unloading is not None:
+        L += _unloading_lines(cal.unloading)
     L.append("## Fitted coefficients\n")
     L.append("| key | value |")
     L.append("|---|---|")
@@ -438,6 +440,31 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
         L.append("## Timing\n")
         L.append(", ".join(f"{k} {v:.1f} s" for k, v in cal.timings.items()) + "\n")
     return "\n".join(L)
+
+
+def _unloading_lines(u) -> list[str]:
+    """The unloading law's fit (``calibration/unloading.py``): coefficients, errors beside
+    Thornton's, the worst branches."""
+    s = u.summary()
+    L = ["## Unloading law (`calibration/unloading.py`)\n",
+         f"F = F_max ξ^m on {s['branches']} unloading branches of the calibration runs, peak state "
+         "from the FE (`model/unloading.py`). Coefficients: "
+         + ", ".join(f"{k} = {_fmt(v)}" for k, v in u.section().items()) + ".\n",
+         "| law | max ΔF/F_max per branch %: median / p95 / max | > 3 % "
+         "| Δh_res/h_max %: median / p95 / max | > 3 % |",
+         "|---|---|---|---|---|"]
+
+    def trio(d):
+        return " / ".join(f"{100 * d[k]:.1f}" for k in ("median", "p95", "max"))
+
+    for lab, F, h in (("fitted", s["F_branch"], s["h_res"]),
+                      ("Thornton (1997)", s["thornton_F_branch"], s["thornton_h_res"])):
+        L.append(f"| {lab} | {trio(F)} | {F['above_3pct']} | {trio(h)} | {h['above_3pct']} |")
+    worst = np.argsort(u.errors)[::-1][:5]
+    L += ["", "Worst branches (fitted law): "
+          + "; ".join(f"{u.curves[i].name} at h_max/R = {u.curves[i].h_max / u.curves[i].R:.3g}: "
+                      f"{100 * u.errors[i]:.1f} %" for i in worst) + ".", ""]
+    return L
 
 
 def write_report(cal: Calibration, out) -> Path:

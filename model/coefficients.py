@@ -174,9 +174,10 @@ class UnloadingCoefficients:
 
     #: s₀: unloading stiffness over Sneddon's 2E*a (with the finite-size terms below)
     stiffness: float = 1.0
-    #: g_a, g_h: each body's stiffness grows by 1 + g_a (a/R_i)² + g_h · 2h_i/R_i
+    #: g_a, g_h, g_ν: each body's stiffness grows by 1 + [g_a (a/R_i)² + g_h · 2h_i/R_i][1 + g_ν (ν_i − 0.3)]
     size_a: float = 0.0
     size_h: float = 0.0
+    size_nu: float = 0.0
     #: exponent m of a fully plastic peak against a flat: m_p + m_c2 ln c²
     m_plastic: float = 1.5
     m_c2: float = 0.0
@@ -193,6 +194,7 @@ class UnloadingCoefficients:
 
 #: allowed ranges of the ``unloading`` section's numbers (``UnloadingCoefficients``)
 UNLOADING_RANGES = {"stiffness": (0.5, 2.0), "size_a": (0.0, 10.0), "size_h": (0.0, 10.0),
+                    "size_nu": (-3.0, 3.0),
                     "m_plastic": (1.0, 2.0), "m_c2": (-1.0, 1.0), "m_counter": (1.0, 2.0),
                     "m_elastic_size": (-1.0, 3.0), "elastic_weight": (0.1, 20.0)}
 

@@ -16,8 +16,9 @@ half-space), and m falls from 3/2 (an elastic peak) to 1.2–1.45 (a plastic one
 more conforming residual profile). The law here (``UnloadingCoefficients``):
 
 * each deformable body i has the compliance C_i = c_i/(2a g_i), c_i = (1 − ν_i²)/E_i,
-  g_i = 1 + g_a (a/R_i)² + g_h · 2h_i/R_i (its contact radius and its own approach at the
-  peak over its radius); δ_e = m F_max C/s₀ with C = Σ C_i;
+  g_i = 1 + [g_a (a/R_i)² + g_h · 2h_i/R_i][1 + g_ν (ν_i − 0.3)] (its contact radius and its
+  own approach at the peak over its radius; the stiffening of a squat body falls with ν);
+  δ_e = m F_max C/s₀ with C = Σ C_i;
 * m = (1 − w)[(1 − U)(m_p + m_c2 ln c²) + U m_counter] + w (3/2 + m_el ȳ²), clipped to
   [1, 3], with the elastic weight w = min(λ, 1)^k, λ = p_m/p_Hertz(a) = 3πR* p_m/(4E*a) (1 at
   an elastic peak, → 0 as the pressure flattens), c² = a²/(2R*h) of the peak, U = u/(1 + u),
@@ -80,6 +81,7 @@ class PeakFeatures(NamedTuple):
     a: np.ndarray           # (n,) contact radius
     h_i: np.ndarray         # (n, 2) each body's approach
     compliance: np.ndarray  # (n, 2) c_i = 1/E'_i
+    nu: np.ndarray          # (n, 2) Poisson's ratio ν_i (any value for a rigid body)
     y: np.ndarray           # (n, 2) a/R_i (0 for a flat)
     z: np.ndarray           # (n, 2) 2h_i/R_i
     lam: np.ndarray         # (n,) λ = 3πR* p_m/(4E* a), at most 1
@@ -88,39 +90,43 @@ class PeakFeatures(NamedTuple):
     onset: np.ndarray       # (n,) r = min(1, s/ONSET), s the larger level weight
 
 
-def features(h, F, a, h_i, compliance, radius, kappa, R_star: float, level_weight_max) -> PeakFeatures:
-    """:class:`PeakFeatures` from the peak values (arrays; ``h_i``, ``compliance``, ``radius``
-    with a last axis of 2, one column per body; radius inf for a flat)."""
+def features(h, F, a, h_i, compliance, nu, radius, kappa, R_star: float,
+             level_weight_max) -> PeakFeatures:
+    """:class:`PeakFeatures` from the peak values (arrays; ``h_i``, ``compliance``, ``nu``,
+    ``radius`` with a last axis of 2, one column per body; radius inf for a flat)."""
     h, F, a = (np.asarray(v, dtype=float) for v in (h, F, a))
     h_i = np.asarray(h_i, dtype=float)
     c = np.broadcast_to(np.asarray(compliance, dtype=float), h_i.shape)
     R = np.broadcast_to(np.asarray(radius, dtype=float), h_i.shape)
+    nu = np.broadcast_to(np.asarray(nu, dtype=float), h_i.shape)
     y = a[:, None] / R
     z = 2.0 * h_i / R
     p_m = F / (math.pi * a * a)
     lam = np.minimum(3.0 * math.pi * R_star * p_m * c.sum(axis=1) / (4.0 * a), 1.0)
     u = a * np.abs(np.asarray(kappa, dtype=float))
-    return PeakFeatures(h=h, F=F, a=a, h_i=h_i, compliance=c, y=y, z=z, lam=lam, U=u / (1.0 + u),
+    return PeakFeatures(h=h, F=F, a=a, h_i=h_i, compliance=c, nu=nu, y=y, z=z, lam=lam, U=u / (1.0 + u),
                         log_c2=np.log(a * a / (2.0 * R_star * h)),
                         onset=np.minimum(np.asarray(level_weight_max, dtype=float) / ONSET, 1.0))
 
 
 def peak_features(p: UnifiedPair, st: UnifiedState) -> PeakFeatures:
     """:class:`PeakFeatures` of the model's loaded states ``st`` of the pair ``p``."""
-    comp, radius, s_max = [], [], np.zeros_like(st.a)
+    comp, nu, radius, s_max = [], [], [], np.zeros_like(st.a)
     for s, Lam in ((p.s1, st.Lambda1), (p.s2, st.Lambda2)):
         comp.append(0.0 if s.is_rigid else 1.0 / s.material.E_prime)
+        nu.append(s.material.nu)
         radius.append(s.radius)
         if not s.is_rigid and math.isfinite(s.material.sigma_y):
             s_max = np.maximum(s_max, level_weight(np.maximum(Lam, 0.0), p.coeffs)[0])
-    return features(st.h, st.F, st.a, np.stack([st.h1, st.h2], axis=1), comp, radius, st.kappa,
+    return features(st.h, st.F, st.a, np.stack([st.h1, st.h2], axis=1), comp, nu, radius, st.kappa,
                     p.R_star, s_max)
 
 
 def unloading_law(f: PeakFeatures, co: UnloadingCoefficients):
     """The law of the module docstring: (m, δ_e, h_res, h_res,1) for the peaks ``f``."""
     c = f.compliance
-    Ci = c / (2.0 * f.a[:, None] * (1.0 + co.size_a * f.y**2 + co.size_h * f.z))
+    Ci = c / (2.0 * f.a[:, None] * (1.0 + (co.size_a * f.y**2 + co.size_h * f.z)
+                                    * (1.0 + co.size_nu * (f.nu - 0.3))))
     C = Ci.sum(axis=1)
     y_bar = (c * f.y).sum(axis=1) / c.sum(axis=1)
     w = f.lam ** co.elastic_weight

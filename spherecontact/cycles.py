@@ -66,6 +66,7 @@ def run_cycles(name: str, run, coeffs: Coefficients) -> list[UnloadingCurve]:
         s2 = s1
     p = pair(s1, s2, coeffs)
     comp = [0.0 if s.is_rigid else 1.0 / s.material.E_prime for s in (s1, s2)]
+    nu = [s.material.nu for s in (s1, s2)]
     radius = [s.radius for s in (s1, s2)]
     R = min(s.radius for s in (s1, s2) if not s.is_rigid)
     h, F = np.asarray(run.curves["h"], dtype=float), np.asarray(run.curves["F"], dtype=float)
@@ -80,7 +81,7 @@ def run_cycles(name: str, run, coeffs: Coefficients) -> list[UnloadingCurve]:
         i0, i1 = int(cyc["increment_peak"][k]), int(cyc["increment_end"][k])
         hm, Fm = float(cyc["h_max"][k]), float(cyc["F_max"][k])
         h_i, kappa = _peak_values(run, scene, i0)
-        pk = features([hm], [Fm], [a_max[k]], [h_i], comp, radius, [kappa], p.R_star, [weight[k]])
+        pk = features([hm], [Fm], [a_max[k]], [h_i], comp, nu, radius, [kappa], p.R_star, [weight[k]])
         out.append(UnloadingCurve(name=f"{name} cycle {k + 1}", h=h[i0:i1 + 1], f=F[i0:i1 + 1] / Fm,
                                   h_max=hm, h_res=float(cyc["h_res"][k]), R=R, peak=pk))
     return out

@@ -48,8 +48,8 @@ def test_default_law_is_thornton():
     """Defaults: Hertz from the peak, δ_e = 3F/(4E*a), m = 3/2 (Thornton 1997)."""
     Ep = 200.0 / (1 - 0.09)
     F, a, h = np.array([2.0, 5.0]), np.array([0.1, 0.2]), np.array([0.05, 0.1])
-    f = features(h, F, a, np.stack([h, 0 * h], axis=1), [1 / Ep, 0.0], [1.0, math.inf], [0.0, 0.0],
-                 1.0, [1.0, 1.0])
+    f = features(h, F, a, np.stack([h, 0 * h], axis=1), [1 / Ep, 0.0], [0.3, 0.3], [1.0, math.inf],
+                 [0.0, 0.0], 1.0, [1.0, 1.0])
     m, delta_e, h_res, h1_res = unloading_law(f, UnloadingCoefficients())
     np.testing.assert_allclose(m, 1.5)
     np.testing.assert_allclose(delta_e, np.minimum(3 * F / (4 * Ep * a), h))

@@ -125,7 +125,8 @@ def test_report_section_tables_and_chart(store, tmp_path):
     assert "ψ_b = 0.9" in sens and "same Δδ" in sens
     lines, pngs = mdr_section(comps, store, tmp_path, cost_n=10_000)
     text = "\n".join(lines)
-    assert "δ = 2h" in text and "Cost per contact evaluation" in text and "waits" in text
+    assert "δ = 2h" in text and "Cost per contact evaluation" in text
+    assert "compares them with the FE's last unloading branch" in text
     assert pngs and pngs[0].stat().st_size > 1000
     lines, pngs = mdr_section(comps, None, tmp_path)
     assert "make peers-mdr" in "\n".join(lines) and not pngs

@@ -97,3 +97,20 @@ def test_validation_rows_and_failures():
     assert unloading_failures(rows, worst * 1.01, 1.0) == []
     fails = unloading_failures(rows, worst * 0.99, 1.0)
     assert len(fails) >= 1 and "F max error" in fails[0]
+
+
+def test_validation_compares_mdr_unloading_where_it_applies():
+    from spherecontact.validation.mdr import load_store
+
+    path = ROOT / "data" / "peers" / "mdr.json"
+    if not path.exists():
+        pytest.skip("data/peers/mdr.json is not present")
+    cases = [c for c in load_cases(DB, "validation")
+             if c.label in ("flat-pp-E250-nu0.3", "flat-K5-n0.3-E300-nu0.3")]
+    rows = unloading_rows(cases, mdr=load_store(path))
+    with_mdr = [r for r in rows if "LAMMPS mdr" in r.F_err]
+    # mdr applies to the perfectly plastic equal pair only, on its last cycle (its stored h_max)
+    assert [(r.run, r.cycle) for r in with_mdr] == [("flat-pp-E250-nu0.3", 4)]
+    r = with_mdr[0]
+    assert r.branches["LAMMPS mdr"].shape == r.curve.h.shape
+    assert 0.0 < r.F_err["LAMMPS mdr"] < 1.0

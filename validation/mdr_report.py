@@ -3,8 +3,8 @@ its unloading curves.
 
 Everything is read from the stored curves (:mod:`.mdr`) and from the comparisons the
 report already made (:func:`.compare.compare_case` with the store), so the section needs
-no LAMMPS. The unloading curves are shown as stored: the FE reference has no unloading
-cycles yet, so their comparison waits for them.
+no LAMMPS. The unloading curves are shown as stored here; :mod:`.unloading` compares them
+with the FE's unloading branches.
 """
 
 from __future__ import annotations
@@ -313,9 +313,9 @@ def mdr_section(comps: list[Comparison], store: MdrStore | None, out: Path, coef
     pngs = []
     md += ["### Unloading", "",
            "mdr unloads elastically from the flattened shape. Its stored unloading curves (from the FE "
-           "run's h_max, same Δδ per step) are listed below; the FE reference has no unloading cycles "
-           "yet, so the comparison of unloading waits for them (the model has no unloading branch "
-           "yet either).", "", unloading_rows(store), ""]
+           "run's h_max, same Δδ per step) are listed below; section \"Unloading and reloading\" "
+           "compares them with the FE's last unloading branch and with the model.", "",
+           unloading_rows(store), ""]
     p = unloading_chart(store, out)
     if p is not None:
         pngs.append(p)

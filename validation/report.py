@@ -98,7 +98,7 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
     cf = default_coefficients() if coeffs is None else coeffs
     comps = [compare_case(c, coeffs, th, mdr) for c in validation if c.h.size >= 2]
     fails = failures(comps, th)
-    unload = unloading_rows(validation, coeffs)
+    unload = unloading_rows(validation, coeffs, mdr)
     unload_fails = unloading_failures(unload, th.F_branch_max, th.h_res_max)
     pngs: list[Path] = []
     md = _header(source, cf, coeff_path, th, th_path, validation, studies, skipped or [])

@@ -15,7 +15,10 @@ Every unloading branch of a validation run (campaign v2 unloads at h/R = 0.01, 0
   critical interference, ``peers.kogut_etsion_critical``), h_res/h_max = 1.02[1 − (ω* + 5.9)^−0.54]
   and F/F_max = ((h − h_res)/(h_max − h_res))^(1.5 ω*^−0.0331); fitted for 1 ≤ ω* ≤ 110: beyond
   it ω* is held at 110 and the cycle flagged (the fit's h_res/h_max exceeds 1 from ω* ≈ 1900 on);
-  F_max from the FE. For two spheres E*, R* and the yield stress and ν of the softer body.
+  F_max from the FE. For two spheres E*, R* and the yield stress and ν of the softer body;
+* **LAMMPS mdr** — its stored unloading from its own loading to the FE run's last h_max
+  (``data/peers/mdr.json``; the scenes mdr applies to, ``mdr.mdr_scene``): compared on the FE's
+  branch from the same h_max, its loading error at the peak included like the model's.
 
 Errors: max |F − F_FE|/F_max,FE along the branch and |h_res − h_res,FE|/h_max. The restitution
 coefficient e = √(W_returned/W_in) of the first cycle (loaded from 0) is compared with the FE's
@@ -39,7 +42,7 @@ from .peers import kogut_etsion_critical
 
 __all__ = ["UnloadingRow", "unloading_rows", "unloading_failures", "ekk_branch", "METHODS"]
 
-METHODS = ("law", "model", "Thornton 1997", "Etsion et al. 2005")
+METHODS = ("law", "model", "Thornton 1997", "Etsion et al. 2005", "LAMMPS mdr")
 #: ω* range of the Etsion–Kligerman–Kadin fit
 EKK_RANGE = (1.0, 110.0)
 
@@ -82,7 +85,23 @@ def _branch_error(f_pred, c: UnloadingCurve) -> float:
     return float(np.max(np.abs(np.asarray(f_pred) - c.f)))
 
 
-def _case_rows(case: Case, co: Coefficients) -> list[UnloadingRow]:
+def _mdr_unloading(case: Case, store):
+    """mdr's stored unloading branch of the case as (h_max, F(h) on the branch), or None."""
+    if store is None:
+        return None
+    from .mdr import mdr_scene
+
+    scene = mdr_scene(case)
+    c = store.find(scene) if isinstance(scene, dict) else None
+    if c is None or c.unloading is None or c.unloading["delta"].size < 3:
+        return None
+    d, F = c.unloading["delta"], c.unloading["F"]
+    order = np.argsort(d)
+    f = c.delta_over_h
+    return float(d[0] / f), lambda h: np.interp(h * f, d[order], F[order], left=0.0)
+
+
+def _case_rows(case: Case, co: Coefficients, store=None) -> list[UnloadingRow]:
     if not case.cycles or "h_max" not in case.cycles:
         return []
     curves = run_cycles(case.label, case, co)
@@ -97,6 +116,7 @@ def _case_rows(case: Case, co: Coefficients) -> list[UnloadingRow]:
     omega_c = kogut_etsion_critical(R_star, E_star, Y, nu)[0] if math.isfinite(Y) else math.inf
     F_fe_max = np.asarray(case.cycles["F_max"], dtype=float)
     cyc_model = cycle(s1, s2, np.array([c.h_max for c in curves]), co)
+    mdr = _mdr_unloading(case, store)
     rows = []
     for k, c in enumerate(curves):
         st = contact(s1, s2, c.h, co, h_max=c.h_max)
@@ -108,19 +128,28 @@ def _case_rows(case: Case, co: Coefficients) -> list[UnloadingRow]:
         w_ret = float(case.cycles["work_returned"][k]) if "work_returned" in case.cycles else math.nan
         first = k == 0
         ws = c.h_max / omega_c
+        F_err, h_err, branches = {}, {}, {}
+        if mdr is not None and math.isclose(mdr[0], c.h_max, rel_tol=1e-3):
+            f_mdr = mdr[1](c.h) / F_fe_max[k]
+            hh = np.linspace(0.0, c.h_max, 4001)
+            on = np.flatnonzero(mdr[1](hh) > 0.0)
+            h_res_mdr = hh[on[0] - 1] if on.size and on[0] > 0 else 0.0
+            F_err["LAMMPS mdr"] = _branch_error(f_mdr, c)
+            h_err["LAMMPS mdr"] = abs(h_res_mdr - c.h_res) / c.h_max
+            branches["LAMMPS mdr"] = f_mdr
         rows.append(UnloadingRow(
             run=case.label, key=case.key, cycle=k + 1, h_over_R=c.h_max / c.R, h_res_fe=c.h_res / c.h_max,
             F_err={"law": float(law_err[k]), "model": _branch_error(f_model, c),
-                   "Thornton 1997": float(th_err[k]), "Etsion et al. 2005": _branch_error(f_ekk, c)},
+                   "Thornton 1997": float(th_err[k]), "Etsion et al. 2005": _branch_error(f_ekk, c), **F_err},
             h_res_err={"law": float(law_hres[k]),
                        "model": abs(float(cyc_model.h_res[k]) - c.h_res) / c.h_max,
                        "Thornton 1997": float(th_hres[k]),
-                       "Etsion et al. 2005": abs(h_res_ekk - c.h_res) / c.h_max},
+                       "Etsion et al. 2005": abs(h_res_ekk - c.h_res) / c.h_max, **h_err},
             e_fe=math.sqrt(max(w_ret / w_in, 0.0)) if first and w_in > 0 else math.nan,
             e_model=float(cyc_model.restitution[k]) if first else math.nan,
             ekk_outside=not (EKK_RANGE[0] <= ws <= EKK_RANGE[1]),
             curve=c, branches={"law": f_law, "model": f_model, "Thornton 1997": f_th,
-                               "Etsion et al. 2005": f_ekk}))
+                               "Etsion et al. 2005": f_ekk, **branches}))
     return rows
 
 
@@ -133,14 +162,15 @@ def _law_branch(law: UnloadingCoefficients, c: UnloadingCurve) -> np.ndarray:
     return xi ** m[0]
 
 
-def unloading_rows(cases: list[Case], coeffs: Coefficients | None = None) -> list[UnloadingRow]:
-    """Every unloading branch of ``cases`` (runs without cycles give none)."""
+def unloading_rows(cases: list[Case], coeffs: Coefficients | None = None, mdr=None) -> list[UnloadingRow]:
+    """Every unloading branch of ``cases`` (runs without cycles give none); ``mdr``: the stored
+    LAMMPS mdr curves (``mdr.load_store``; None: mdr left out)."""
     co = default_coefficients() if coeffs is None else coeffs
     out = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # calibrated-range warnings are reported by the loading part
         for case in cases:
-            out += _case_rows(case, co)
+            out += _case_rows(case, co, mdr)
     return out
 
 

@@ -14,7 +14,7 @@ from .unloading import METHODS, UnloadingRow, unloading_failures
 __all__ = ["unloading_section", "summary_table", "run_rows", "COLORS"]
 
 COLORS = {"law": "tab:blue", "model": "tab:cyan", "Thornton 1997": "tab:orange",
-          "Etsion et al. 2005": "tab:green"}
+          "Etsion et al. 2005": "tab:green", "LAMMPS mdr": "tab:red"}
 
 
 def _stats(x) -> tuple[float, float, float]:
@@ -28,12 +28,14 @@ def summary_table(rows: list[UnloadingRow], F_limit: float, h_res_limit: float) 
     """Per method: median / 95th percentile / max of the branch errors, and the branches above the limits."""
     out = []
     for m in METHODS:
-        F = [r.F_err[m] for r in rows]
-        hr = [r.h_res_err[m] for r in rows]
+        F = [r.F_err[m] for r in rows if m in r.F_err]
+        hr = [r.h_res_err[m] for r in rows if m in r.h_res_err]
+        if not F:
+            continue
         f, h = _stats(F), _stats(hr)
-        out.append([m, " / ".join(pct(v) for v in f), sum(v > F_limit for v in F),
+        out.append([m, len(F), " / ".join(pct(v) for v in f), sum(v > F_limit for v in F),
                     " / ".join(pct(v) for v in h), sum(v > h_res_limit for v in hr)])
-    return markdown_table(["method", "max |ΔF|/F_max %: median / p95 / max",
+    return markdown_table(["method", "branches", "max |ΔF|/F_max %: median / p95 / max",
                            f"branches > {pct(F_limit, 0)} %", "|Δh_res|/h_max %: median / p95 / max",
                            f"branches > {pct(h_res_limit, 0)} %"], out)
 
@@ -47,8 +49,12 @@ def run_rows(rows: list[UnloadingRow]) -> str:
     for run, rs in by_run.items():
         cells = [run, " ".join(f"{r.h_over_R:.2g}" for r in rs)]
         for m in METHODS:
-            w = max(rs, key=lambda r: r.F_err[m])
-            cells.append(f"{pct(w.F_err[m])} / {pct(max(r.h_res_err[m] for r in rs))}"
+            have = [r for r in rs if m in r.F_err]
+            if not have:
+                cells.append("—")
+                continue
+            w = max(have, key=lambda r: r.F_err[m])
+            cells.append(f"{pct(w.F_err[m])} / {pct(max(r.h_res_err[m] for r in have))}"
                          + (" ‡" if m == "Etsion et al. 2005" and any(r.ekk_outside for r in rs) else ""))
         first = rs[0]
         cells.append(f"{first.e_fe:.3f} / {first.e_model:.3f}" if math.isfinite(first.e_fe) else "—")
@@ -61,9 +67,10 @@ def _error_chart(rows: list[UnloadingRow], F_limit: float, out: Path) -> Path:
     plt = pyplot()
     fig, ax = plt.subplots(1, 2, figsize=(10, 3.8))
     for m in METHODS:
-        x = [r.h_over_R for r in rows]
-        ax[0].scatter(x, [100 * r.F_err[m] for r in rows], s=12, color=COLORS[m], label=m, alpha=0.8)
-        ax[1].scatter(x, [100 * r.h_res_err[m] for r in rows], s=12, color=COLORS[m], label=m, alpha=0.8)
+        have = [r for r in rows if m in r.F_err]
+        x = [r.h_over_R for r in have]
+        ax[0].scatter(x, [100 * r.F_err[m] for r in have], s=12, color=COLORS[m], label=m, alpha=0.8)
+        ax[1].scatter(x, [100 * r.h_res_err[m] for r in have], s=12, color=COLORS[m], label=m, alpha=0.8)
     for a, t in zip(ax, ("max |ΔF|/F_max along the branch (%)", "|Δh_res|/h_max (%)"), strict=True):
         a.set_xscale("log")
         a.set_yscale("log")
@@ -107,7 +114,7 @@ def _branches_chart(rows: list[UnloadingRow], out: Path) -> Path:
         c = r.curve
         x = (c.h_max - c.h) / c.h_max
         ax.plot(x, c.f, "k-", lw=2.0, label="FE")
-        for m in METHODS:
+        for m in (m for m in METHODS if m in r.branches):
             ax.plot(x, r.branches[m], ls="--" if m in ("law", "model") else ":", color=COLORS[m],
                     lw=1.2, label=m)
         ax.set_title(f"{r.run[:34]}\nh_max/R = {r.h_over_R:.3g}", fontsize=7)
@@ -164,7 +171,8 @@ def unloading_section(rows: list[UnloadingRow], F_limit: float, h_res_limit: flo
            "loading to the FE's h_max (its loading error at the peak included); Thornton (1997) — "
            "Hertz from the FE's peak; Etsion, Kligerman & Kadin (2005) — their FE fit for an "
            "elastic–perfectly plastic sphere on a rigid flat, with the FE's F_max (‡: a cycle outside "
-           "its fitted range 1 ≤ ω* ≤ 110).", "",
+           "its fitted range 1 ≤ ω* ≤ 110); LAMMPS mdr — its stored unloading after its own loading to "
+           "the FE run's last h_max, where mdr applies (its loading error included).", "",
            summary_table(rows, F_limit, h_res_limit), "",
            f"Acceptance (law): max |ΔF|/F_max ≤ {pct(F_limit, 0)} % along each branch and "
            f"|Δh_res| ≤ {pct(h_res_limit, 0)} % of h_max: "
