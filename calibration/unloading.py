@@ -31,7 +31,8 @@ __all__ = ["UnloadingFit", "fit_unloading", "START", "TAIL"]
 TAIL = 0.03
 
 #: start of the fit (Thornton's exponent and stiffness, moderate terms elsewhere)
-START = UnloadingCoefficients(stiffness=1.0, size_a=1.0, size_h=1.0, size_nu=0.0, m_plastic=1.3, m_c2=0.0,
+START = UnloadingCoefficients(stiffness=1.0, size_a=1.0, size_h=1.0, size_nu=0.0, m_plastic=1.3,
+                              m_c2=0.0, m_depth=0.0,
                               m_counter=1.5, m_elastic_size=0.0, elastic_weight=1.0)
 @dataclass
 class UnloadingFit:

@@ -178,9 +178,11 @@ class UnloadingCoefficients:
     size_a: float = 0.0
     size_h: float = 0.0
     size_nu: float = 0.0
-    #: exponent m of a fully plastic peak against a flat: m_p + m_c2 ln c²
+    #: exponent m of a fully plastic peak against a flat: m_p + m_c2 ln c² + m_depth z̄ (z̄: the
+    #: compliance-weighted 2h_i/R_i)
     m_plastic: float = 1.5
     m_c2: float = 0.0
+    m_depth: float = 0.0
     #: ... against a curved counter-surface (u = a|κ| → ∞)
     m_counter: float = 1.5
     #: ... of an elastic peak: 3/2 + m_elastic_size ȳ²
@@ -195,7 +197,8 @@ class UnloadingCoefficients:
 #: allowed ranges of the ``unloading`` section's numbers (``UnloadingCoefficients``)
 UNLOADING_RANGES = {"stiffness": (0.5, 2.0), "size_a": (0.0, 10.0), "size_h": (0.0, 10.0),
                     "size_nu": (-3.0, 3.0),
-                    "m_plastic": (1.0, 2.0), "m_c2": (-1.0, 1.0), "m_counter": (1.0, 2.0),
+                    "m_plastic": (1.0, 2.0), "m_c2": (-1.0, 1.0), "m_depth": (-2.0, 2.0),
+                    "m_counter": (1.0, 2.0),
                     "m_elastic_size": (-1.0, 3.0), "elastic_weight": (0.1, 20.0)}
 
 #: allowed ranges of the ``interface`` section's numbers

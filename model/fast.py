@@ -68,6 +68,9 @@ _WIDER = 0.7       # ln a of the grid's top above the Hertz radius of h_max
 _EXTEND = 8        # grid steps added at a time where the grid falls short of an end
 _MAX_EXTEND = 100  # extensions before h(a) is taken not to reach an end (16 in ln a)
 _END_STEP = 1e-6   # largest Newton step (ln a) of an end taken without the exact inversion
+#: target bound of the unloading branch's F error (relative to F_max) from the linear
+#: interpolation of the recovery and exponent between nodes (``ContactLaw._unloading_error``)
+UNLOADING_RTOL = 1e-3
 
 
 def _midpoints(nodes: np.ndarray, bad: np.ndarray) -> np.ndarray:
@@ -142,9 +145,15 @@ class ContactLaw:
 
     Attributes
     ----------
-    error : dict of measured error bounds (relative) for ``F``, ``a``, ``stiffness``, ``h1``.
+    error : dict of measured error bounds (relative) for ``F``, ``a``, ``stiffness``, ``h1``,
+        and ``unloading_F`` (F on unloading branches, relative to F_max; target ``UNLOADING_RTOL``).
     setup_time : seconds spent building the table.
     nodes : number of table nodes; ``kinks``: the approaches h where the model has kinks.
+    unloading_table : plain arrays at the table's nodes for the unloading branch of a peak
+        there (``unloading.py``): ``ln_h`` (the nodes, ln of the peak approach), ``recovery``
+        δ_e/h_max (1: an elastic peak, which returns along the loading curve), ``m`` (exponent
+        of F = F_max ξ^m) and ``h1_res`` (body 1's residual approach over h_max); linear in
+        ln h between nodes. With the loading table they define ``force(h, h_max)`` completely.
     range_issues : dict cause → message of every calibrated-range warning this law has
         issued (material and pair causes at build; approach causes when first met).
     h_calibrated : largest approach at which every approach-dependent check of the
@@ -402,7 +411,7 @@ class ContactLaw:
         self._un = {k: (tab[k][:-1].copy(), np.diff(tab[k])) for k in ("recovery", "m", "h1_res")}
         # peaks up to the last node of the elastic prefix (recovery 1: Level I) unload along the
         # loading curve
-        plastic = np.flatnonzero(tab["recovery"] < 1.0)
+        plastic = np.flatnonzero(tab["recovery"] < 1.0 - 1e-9)  # the node at Λ_I may be 1 − 1e-12
         first = plastic[0] if plastic.size else s.size
         self._h_elastic = float(np.exp(s[first - 1])) if first > 0 else 0.0
         self._build_lookup()
@@ -429,12 +438,30 @@ class ContactLaw:
         eF, ea, ek = (_SAFETY * np.abs(x / y - 1.0) for x, y in ((F, st.F), (a, st.a), (k, st.stiffness)))
         n = self._lnX_nodes.size - 1  # probes are ordered interval by interval
         bad = (np.maximum(np.maximum(eF, ea), ek) > self.rtol).reshape(n, len(_PROBES)).any(axis=1)
+        eU = self._unloading_error(st)
+        bad |= (eU > UNLOADING_RTOL).reshape(n, len(_PROBES)).any(axis=1)
         return {
             "F": float(np.max(eF)),
             "a": float(np.max(ea)),
             "stiffness": float(np.max(ek)),
             "h1": _SAFETY * float(np.max(np.abs(h1 - st.h1) / st.h)),
+            "unloading_F": float(np.max(eU)),
         }, bad
+
+    def _unloading_error(self, st: UnifiedState) -> np.ndarray:
+        """Bound on the unloading branch's F error (relative to F_max) of the linear recovery and
+        exponent at exact states ``st``: |Δδ_e|/δ_e + |Δm|/(e m) (F = F_max ξ^m: a relative
+        error ε of δ_e moves F by at most ~ε F_max, an error Δm by at most Δm/(e m) F_max), × the
+        safety factor."""
+        pk = peak_parameters(self.pair, st)
+        s = np.log(st.h)
+        j = self._index(s)
+        t = (s - self._s[j]) * self._inv_ds[j]
+        r0, dr = self._un["recovery"]
+        m0, dm = self._un["m"]
+        rec, m = r0[j] + t * dr[j], m0[j] + t * dm[j]
+        exact = pk.delta_e / st.h
+        return _SAFETY * (np.abs(rec / exact - 1.0) + np.abs(m - pk.m) / (math.e * pk.m))
 
     # ------------------------------------------------------------------ calibrated range
     def _range_thresholds(self) -> None:
@@ -611,8 +638,12 @@ class ContactLaw:
         loading = h >= hm
         loading |= hm <= self._h_elastic
         q = np.where(loading, h, hm)               # where the table is read
-        if q.size and (q.min() < self.h_min or q.max() > self.h_max):
+        if q.size and q.max() > self.h_max:
             return None
+        low = q < self.h_min                       # h ≤ 0 (no contact) or below the table
+        any_low = bool(low.any())
+        if any_low:
+            q[low] = self.h_min
         s = np.log(q)
         j = self._index(s)
         inv = self._inv_ds[j]
@@ -655,7 +686,13 @@ class ContactLaw:
         m1 += 1.0
         w *= m1
         w /= delta                                 # unloading stiffness
-        return F, np.where(loading, dy, w)
+        k = np.where(loading, dy, w)
+        if any_low:
+            F[low], k[low] = 0.0, 0.0
+            pos = low & (h > 0.0)                  # 0 < h < h_min: the exact solve
+            if pos.any():
+                F[pos], k[pos] = self.force(h[pos])
+        return F, k
 
     def _unload_force(self, h, hm):
         """F and dF/dh on the unloading branches of peaks at hm > h, all inside the table (the
@@ -676,7 +713,7 @@ class ContactLaw:
         k = np.exp(ln_Fmax + (m - 1.0) * lx) * on
         F = k * np.where(on, xi, 0.0)
         k *= m / delta
-        elastic = rec >= 1.0
+        elastic = hm <= self._h_elastic
         if elastic.any():  # an elastic peak returns along the loading curve
             e = elastic & (h > 0.0)
             F[elastic], k[elastic] = 0.0, 0.0
@@ -699,7 +736,7 @@ class ContactLaw:
         a = a_max * xm1
         h1_res = h1r * hm
         h1 = np.where(on, h1_res + xi * (h1_max - h1_res), 0.0)
-        elastic = (rec >= 1.0) & (h > 0.0)
+        elastic = (hm <= self._h_elastic) & (h > 0.0)
         if elastic.any():
             if full:
                 st = self(h[elastic])

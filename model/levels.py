@@ -46,6 +46,10 @@ __all__ = [
     "finite_size_factor",
     "counter_surface",
     "level_weight",
+    "ONSET",
+    "onset_Lambda",
+    "onset_ramp",
+    "stage",
     "finite_size_by_level",
     "collapse_blend",
     "CollapseBlend",
@@ -267,6 +271,39 @@ def counter_surface(x, y):
     d = 1.0 + u * u
     ds_du = 2.0 * up / (d * d)
     return up * up / d, ds_du * x, -ds_du * y
+
+
+#: level weight at which the residual approach after unloading reaches the unloading law's
+#: value (``unloading.py``: it ramps from 0 at Λ_I, linearly in ln Λ, :func:`onset_ramp`); the
+#: smooth-piece ids change there, so the fast path puts a node at the end of the ramp
+ONSET = 1e-3
+
+
+def onset_Lambda(coeffs: Coefficients) -> float:
+    """Λ where the level weight s = 3t² − 2t³ reaches ``ONSET`` (t by fixed-point iteration of
+    t = √((ONSET + 2t³)/3), which converges in a few steps for small ONSET)."""
+    t = math.sqrt(ONSET / 3.0)
+    for _ in range(20):
+        t = math.sqrt((ONSET + 2.0 * t**3) / 3.0)
+    return coeffs.Lambda_I * (coeffs.Lambda_III / coeffs.Lambda_I) ** t
+
+
+def onset_ramp(Lambda, coeffs: Coefficients) -> np.ndarray:
+    """r = ln(Λ/Λ_I)/ln(Λ_on/Λ_I) clipped to [0, 1] (Λ_on: :func:`onset_Lambda`): 0 in Level I, 1
+    from the end of the onset on; linear in ln Λ, so the fast path's linear interpolation in
+    ln h between the nodes at Λ_I and Λ_on follows it closely."""
+    L = np.asarray(Lambda, dtype=float)
+    with np.errstate(divide="ignore"):
+        r = np.log(np.maximum(L, 0.0) / coeffs.Lambda_I) / math.log(onset_Lambda(coeffs) / coeffs.Lambda_I)
+    return np.clip(r, 0.0, 1.0)
+
+
+def stage(Lambda, coeffs: Coefficients) -> np.ndarray:
+    """Smooth-piece stage of Λ: 0 Level I, 1 Level II before the unloading onset
+    (:func:`onset_Lambda`), 2 the rest of Level II, 3 Level III."""
+    L = np.asarray(Lambda, dtype=float)
+    lev = level(L, coeffs)
+    return np.where(lev == 1, 0, np.where(lev == 3, 3, np.where(L >= onset_Lambda(coeffs), 2, 1)))
 
 
 def level_weight(Lambda, coeffs: Coefficients):

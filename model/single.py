@@ -49,9 +49,9 @@ from .levels import (
     collapse_blend,
     counter_surface,
     finite_size_by_level,
-    level,
     level_weight,
     levels_scalar_n,
+    stage,
 )
 from .material import Material
 
@@ -204,9 +204,10 @@ class BodyLaw:
         s, ds = level_weight(mat.E_prime * x / sig, co)
         return s, ds * (1.0 - m), self.H_bar_III * sig, m
 
-    def _piece(self, lev, eps, y) -> np.ndarray:
-        """Smooth-piece id from the level, ε_rep (flow-table segment) and y (beyond x_fit_max)."""
-        piece = lev + 3 * _segment(self.material, eps)
+    def _piece(self, Lam, eps, y) -> np.ndarray:
+        """Smooth-piece id from the stage of Λ (``levels.stage``: the levels, and the end of the
+        unloading onset ramp in Level II), ε_rep (flow-table segment) and y (beyond x_fit_max)."""
+        piece = stage(Lam, self.coeffs) + 4 * _segment(self.material, eps)
         if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
             piece = 2 * piece + (y > self.x_fit_max)
         return piece
@@ -223,7 +224,7 @@ class BodyLaw:
             Lam = np.zeros_like(x)
         else:
             Lam = mat.E_prime * x / mat.flow_stress(eps)
-        return self._piece(level(Lam, co), eps, y)
+        return self._piece(Lam, eps, y)
 
     def response(self, x, y=None, z: float = 0.0) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
@@ -249,7 +250,7 @@ class BodyLaw:
         xm = self.x_fit_max
         fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
         fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
-        piece = self._piece(lev, eps, y)
+        piece = self._piece(Lam, eps, y)
         p, c = p * fH, c * fc
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc

@@ -5,8 +5,8 @@ its peak (h_max, F_max, a_max; the increments of the peak and of the end) and th
 F(h) down to the residual approach h_res. :func:`run_cycles` turns each into an
 :class:`UnloadingCurve`: the branch as F/F_max at the FE's approaches and the peak as the
 law's ``PeakFeatures`` — F, a, each body's approach h_i and the curvature κ of the contact
-surface from the FE; only the level weight of the onset ramp comes from the model (the
-loading coefficients' Λ at the FE's a_max). Calibration fits the law to these; validation
+surface from the FE; only the onset ramp comes from the model (the loading coefficients' Λ
+at the FE's a_max, ``levels.onset_ramp``). Calibration fits the law to these; validation
 scores it on them (:func:`branch_errors`).
 """
 
@@ -19,7 +19,7 @@ import numpy as np
 
 from .fem.io import spheres_from_inputs
 from .model.coefficients import Coefficients, UnloadingCoefficients
-from .model.levels import level_weight
+from .model.levels import onset_ramp
 from .model.unified import pair
 from .model.unloading import PeakFeatures, features, unloading_law
 
@@ -75,7 +75,7 @@ def run_cycles(name: str, run, coeffs: Coefficients) -> list[UnloadingCurve]:
     weight = np.zeros_like(a_max)
     for s, Lam in ((s1, st.Lambda1), (s2, st.Lambda2)):
         if not s.is_rigid and math.isfinite(s.material.sigma_y):
-            weight = np.maximum(weight, level_weight(np.maximum(Lam, 0.0), coeffs)[0])
+            weight = np.maximum(weight, onset_ramp(Lam, coeffs))
     out = []
     for k in range(len(a_max)):
         i0, i1 = int(cyc["increment_peak"][k]), int(cyc["increment_end"][k])
