@@ -226,19 +226,27 @@ def _counter(d: dict) -> dict:
     return out
 
 
+def _ranged(d: dict, name: str, ranges: dict) -> dict | None:
+    """The numbers of the optional section ``name``, each within its range (None if absent)."""
+    if name not in d:
+        return None
+    sec = _section(d, name)
+    out = {}
+    for key, (lo, hi) in ranges.items():
+        v = _number(sec, key, f"{name}.")
+        if not lo <= v <= hi:
+            raise ValueError(f"coefficients: '{name}.{key}' must lie in [{lo:g}, {hi:g}], got {v!r}")
+        out[key] = v
+    return out
+
+
 def _unloading(d: dict) -> dict:
     """The optional ``unloading`` section as the ``Coefficients.unloading`` field (absent:
     Thornton's defaults)."""
-    if "unloading" not in d:
+    values = _ranged(d, "unloading", UNLOADING_RANGES)
+    if values is None:
         return {}
-    sec = _section(d, "unloading")
-    values = {}
-    for key, (lo, hi) in UNLOADING_RANGES.items():
-        v = _number(sec, key, "unloading.")
-        if not lo <= v <= hi:
-            raise ValueError(f"coefficients: 'unloading.{key}' must lie in [{lo:g}, {hi:g}], got {v!r}")
-        values[key] = v
-    unknown = sorted(set(sec) - set(UNLOADING_RANGES))
+    unknown = sorted(set(d["unloading"]) - set(UNLOADING_RANGES))
     if unknown:
         raise ValueError(f"coefficients: unknown key 'unloading.{unknown[0]}' "
                          f"(allowed: {', '.join(UNLOADING_RANGES)})")
@@ -247,16 +255,8 @@ def _unloading(d: dict) -> dict:
 
 def _interface(d: dict) -> dict:
     """The optional ``interface`` section as ``Coefficients`` fields (absent: no coupling)."""
-    if "interface" not in d:
-        return {}
-    sec = _section(d, "interface")
-    out = {}
-    for key, (lo, hi) in _INTERFACE_RANGES.items():
-        v = _number(sec, key, "interface.")
-        if not lo <= v <= hi:
-            raise ValueError(f"coefficients: 'interface.{key}' must lie in [{lo:g}, {hi:g}], got {v!r}")
-        out[f"interface_{key}"] = v
-    return out
+    values = _ranged(d, "interface", _INTERFACE_RANGES)
+    return {} if values is None else {f"interface_{k}": v for k, v in values.items()}
 
 
 def _number(d: dict, key: str, where: str) -> float:
