@@ -2,6 +2,9 @@
 
 A thin layer over :func:`curve`, which tests call directly. Body 2 defaults to a copy
 of body 1 (equal spheres); ``--radius2 inf`` gives a flat, ``--E2 inf`` a rigid body.
+``--unload`` appends the unloading branch from h_max to the residual approach (column
+``branch``: 0 load, 1 unload) and the cycle's residual approach, energies and quasi-static
+restitution coefficient (``cycle.py``).
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import numpy as np
 
 from .coefficients import default_coefficients, load_coefficients
 from .contact import contact
+from .cycle import cycle
 from .material import Material
 from .sphere import Sphere
 
@@ -30,10 +34,14 @@ def _material(E, nu, sigma_y, K, n) -> Material:
     return Material(E=E, nu=nu, sigma_y=sigma_y, K=K, n=n)
 
 
-def curve(s1: Sphere, s2: Sphere, h_max: float, points: int = 50, coeffs=None) -> dict:
-    """Model curve at ``points`` approaches h = h_max·i/points, i = 1..points.
+def curve(s1: Sphere, s2: Sphere, h_max: float, points: int = 50, coeffs=None,
+          unload: bool = False) -> dict:
+    """Model curve at ``points`` approaches h = h_max·i/points, i = 1..points; with ``unload``
+    then ``points`` more on the unloading branch from h_max down to the residual approach.
 
-    Returns a dict of lists (``h``, ``F``, ``a``, ``h1``, ``h2``, ``stiffness``).
+    Returns a dict of lists (``h``, ``F``, ``a``, ``h1``, ``h2``, ``stiffness``; with
+    ``unload`` also ``branch``, 0 load / 1 unload, and ``cycle``: h_res, each body's share,
+    work in and returned, dissipated work, restitution coefficient).
     """
     if not (math.isfinite(h_max) and h_max > 0.0):
         raise ValueError(f"--h-max must be a finite number > 0, got {h_max!r}")
@@ -43,7 +51,17 @@ def curve(s1: Sphere, s2: Sphere, h_max: float, points: int = 50, coeffs=None) -
     st = contact(s1, s2, h, coeffs)
     out = {"h": h}
     out.update({k: getattr(st, k) for k in COLUMNS[1:]})
-    return {k: np.asarray(v, dtype=float).tolist() for k, v in out.items()}
+    if not unload:
+        return {k: np.asarray(v, dtype=float).tolist() for k, v in out.items()}
+    c = cycle(s1, s2, h_max, coeffs)
+    hu = h_max - (h_max - float(c.h_res)) * np.arange(1, points + 1) / points
+    su = contact(s1, s2, hu, coeffs, h_max=h_max)
+    data = {k: np.concatenate([out[k], hu if k == "h" else getattr(su, k)]).tolist() for k in COLUMNS}
+    data["branch"] = [0] * points + [1] * points
+    data["cycle"] = {k: float(getattr(c, k)) for k in ("h_max", "F_max", "a_max", "h_res", "h1_res",
+                                                        "h2_res", "work_in", "work_returned",
+                                                        "dissipated", "restitution")}
+    return data
 
 
 def run_curve(args: argparse.Namespace) -> int:
@@ -59,19 +77,24 @@ def run_curve(args: argparse.Namespace) -> int:
     s1 = Sphere(radius=args.radius, material=m1)
     s2 = Sphere(radius=args.radius if args.radius2 is None else args.radius2, material=m2)
     coeffs = load_coefficients(args.coefficients) if args.coefficients else default_coefficients()
-    data = curve(s1, s2, args.h_max, args.points, coeffs)
+    data = curve(s1, s2, args.h_max, args.points, coeffs, unload=args.unload)
+    cyc = data.pop("cycle", None)
+    cols = COLUMNS + (("branch",) if args.unload else ())
     meta = {
         "body1": {"radius": s1.radius, **m1.describe()},
         "body2": {"radius": s2.radius, **m2.describe()},
         "coefficients_source": coeffs.source,
         "units": "consistent units of the inputs",
+        **({"cycle": cyc} if cyc else {}),
     }
     if args.json:
         text = json.dumps({"meta": meta, **data}, indent=1)
     else:
-        lines = [f"# spherecontact model curve; coefficients: {coeffs.source}",
-                 ",".join(COLUMNS)]
-        lines += [",".join(f"{data[c][i]:.10g}" for c in COLUMNS) for i in range(len(data["h"]))]
+        lines = [f"# spherecontact model curve; coefficients: {coeffs.source}"]
+        if cyc:
+            lines.append("# cycle: " + ", ".join(f"{k} = {v:.6g}" for k, v in cyc.items()))
+        lines.append(",".join(cols))
+        lines += [",".join(f"{data[c][i]:.10g}" for c in cols) for i in range(len(data["h"]))]
         text = "\n".join(lines)
     if args.out:
         Path(args.out).write_text(text + "\n")
@@ -103,6 +126,8 @@ def register(subparsers) -> None:
     p.add_argument("--h-max", type=float, required=True, help="largest approach h")
     p.add_argument("--points", type=int, default=50, help="number of points (default 50)")
     p.add_argument("--coefficients", help="coefficient JSON file (default data/coefficients.json)")
+    p.add_argument("--unload", action="store_true",
+                   help="append the unloading branch to the residual approach and the cycle's energies")
     p.add_argument("--json", action="store_true", help="write JSON instead of CSV")
     p.add_argument("--out", help="output file (default: stdout)")
     p.set_defaults(func=run_curve)

@@ -216,3 +216,17 @@ def test_unloading_section_round_trip_and_errors(co):
     missing = dict(d, unloading={k: v for k, v in d["unloading"].items() if k != "m_c2"})
     with pytest.raises(ValueError, match=r"unloading\.m_c2"):
         Coefficients.from_dict(missing)
+
+
+def test_cli_curve_with_unloading(co):
+    from spherecontact.model.cli import curve
+
+    d = curve(Sphere(1.0, EPP), WALL, 0.1, points=5, coeffs=co, unload=True)
+    assert d["branch"] == [0] * 5 + [1] * 5
+    h, F = np.array(d["h"]), np.array(d["F"])
+    assert np.all(np.diff(h[5:]) < 0.0) and np.all(np.diff(F[5:]) < 0.0)  # unloading
+    assert F[-1] == 0.0 and h[-1] == pytest.approx(d["cycle"]["h_res"])
+    assert 0.0 < d["cycle"]["restitution"] < 1.0
+    assert d["cycle"]["h_res"] == pytest.approx(residual_approach(Sphere(1.0, EPP), WALL, 0.1))
+    plain = curve(Sphere(1.0, EPP), WALL, 0.1, points=5, coeffs=co)
+    assert "branch" not in plain and plain["F"] == d["F"][:5]
