@@ -873,6 +873,26 @@ class ContactLaw:
     def nodes(self) -> int:
         return int(self._s.size)
 
+    def tables(self) -> dict:
+        """The table as plain arrays, enough to evaluate ``force(h, h_max)`` elsewhere (a DEM code).
+
+        Keys: ``ln_h`` (n nodes, increasing), ``ln_F_hermite`` (n − 1, 4): c₀…c₃ of
+        ln F = c₀ + c₁t + c₂t² + c₃t³ on interval j, t = (ln h − ln_h[j])/(ln_h[j+1] − ln_h[j]);
+        ``recovery`` and ``m`` (n): δ_e/h_max and the exponent of a peak at each node, linear in
+        t; ``h_elastic``: peaks up to it unload along the loading curve; ``h_min``, ``h_max``: the
+        table's range (outside it, the exact solve). For a contact at h with largest approach hm:
+
+        * loading (h ≥ hm) or elastic peak (hm ≤ h_elastic): q = h, F = exp(ln F(q)),
+          dF/dh = F (d ln F/dt)/(q Δ_j), Δ_j = ln_h[j+1] − ln_h[j];
+        * else q = hm, δ_e = recovery(q)·hm, ξ = clip((h − hm)/δ_e + 1, 0, 1),
+          F = exp(ln F(q)) ξ^m, dF/dh = m exp(ln F(q)) ξ^(m−1)/δ_e (0 at ξ = 0);
+        * h ≤ 0: F = dF/dh = 0.
+        """
+        return {"ln_h": self._s.copy(), "ln_F_hermite": self._cF.copy(),
+                "recovery": self.unloading_table["recovery"].copy(),
+                "m": self.unloading_table["m"].copy(), "h_elastic": self._h_elastic,
+                "h_min": self.h_min, "h_max": self.h_max}
+
     def describe(self) -> dict:
         """Plain-dict summary: range, node count, measured error bounds, setup time."""
         return {

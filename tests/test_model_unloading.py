@@ -230,3 +230,38 @@ def test_cli_curve_with_unloading(co):
     assert d["cycle"]["h_res"] == pytest.approx(residual_approach(Sphere(1.0, EPP), WALL, 0.1))
     plain = curve(Sphere(1.0, EPP), WALL, 0.1, points=5, coeffs=co)
     assert "branch" not in plain and plain["F"] == d["F"][:5]
+
+
+def _force_from_tables(tab, h, hm):
+    """force(h, h_max) from ContactLaw.tables() alone, as a DEM code would (its docstring)."""
+    s = tab["ln_h"]
+    loading = (h >= hm) | (hm <= tab["h_elastic"])
+    q = np.where(loading, h, hm)
+    j = np.clip(np.searchsorted(s, np.log(q), side="right") - 1, 0, s.size - 2)
+    width = s[j + 1] - s[j]
+    t = (np.log(q) - s[j]) / width
+    c = tab["ln_F_hermite"][j]
+    lnF = c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
+    dlnF = (c[:, 1] + t * (2 * c[:, 2] + 3 * t * c[:, 3])) / width
+    rec = tab["recovery"][j] + t * (tab["recovery"][j + 1] - tab["recovery"][j])
+    m = tab["m"][j] + t * (tab["m"][j + 1] - tab["m"][j])
+    delta = rec * q
+    xi = np.clip((h - q) / delta + 1.0, 0.0, 1.0)
+    Fq = np.exp(lnF)
+    F = np.where(loading, Fq, Fq * xi**m)
+    k = np.where(loading, Fq * dlnF / q, np.where(xi > 0, m * Fq * xi ** (m - 1) / delta, 0.0))
+    return F, k
+
+
+def test_exported_tables_reproduce_the_fast_path(co):
+    for s2 in (WALL, Sphere(0.5, HARD)):
+        law = ContactLaw(Sphere(1.0, EPP), s2)
+        tab = law.tables()
+        rng = np.random.default_rng(1)
+        hm = np.exp(rng.uniform(np.log(1e-6), np.log(law.h_max), 2000))
+        h = np.minimum(hm * rng.uniform(0.5, 1.2, hm.size), law.h_max)  # inside the table
+        F, k = _force_from_tables(tab, h, hm)
+        Ff, kf = law.force(h, hm)
+        np.testing.assert_allclose(F, Ff, rtol=1e-12, atol=1e-300)
+        np.testing.assert_allclose(k, kf, rtol=1e-9, atol=1e-300)
+        assert tab["ln_F_hermite"].shape == (tab["ln_h"].size - 1, 4)
