@@ -39,7 +39,7 @@ from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
 from .interface import InterfaceFit, fit_interface, load_pairs, two_body_runs
 from .threads import single_threaded_blas
-from .unloading import UnloadingFit, fit_unloading
+from .unloading import TAIL, UnloadingFit, fit_unloading
 from .workers import DEFAULT_WORKERS, Workers
 
 __all__ = ["Calibration", "calibrate_runs", "calibrate", "load_runs", "coefficient_file",
@@ -417,7 +417,8 @@ def coefficient_file(cal: Calibration) -> dict:
         d["unloading"] = u.section()
         d["provenance"]["unloading_fit"] = {
             "method": "least squares of F/F_max along every unloading branch of the calibration runs, "
-                      "peak state from the FE (calibration/unloading.py)",
+                      f"residuals r as r*sqrt(1 + (r/{TAIL:g})^2) (the worst branches weigh more), peak "
+                      "state from the FE (calibration/unloading.py)",
             **{k: ({q: (_stat(x) if isinstance(x, float) else x) for q, x in v.items()}
                   if isinstance(v, dict) else v)
                for k, v in u.summary().items()}}
