@@ -226,10 +226,16 @@ class BodyLaw:
             Lam = mat.E_prime * x / mat.flow_stress(eps)
         return self._piece(Lam, eps, y)
 
-    def response(self, x, y=None, z: float = 0.0) -> BodyResponse:
+    def response(self, x, y=None, z: float = 0.0, xc=None) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
         ``z`` the curvature ratio of the collapse limits (a constant of the pair,
-        :func:`curvature_ratio`)."""
+        :func:`curvature_ratio`); ``xc`` the contact radius over the body's Hertz relative
+        radius ρ_H (a constant of the pair times a) for the counter-surface terms, u = xc − y
+        (default x: against a rigid surface ρ = ρ_H). Given ``xc``, those terms depend on a
+        alone, not on the partition: their slopes go to the y slot, so that they leave the
+        two-body κ equation monotone in u (``unified.py``; with u = x − y the pressure term's
+        negative slope in x made the κ equation lose its single root for some plastic pairs).
+        With the c² term alone on u = x − y the pair grid's monotonicity check fails."""
         mat, co = self.material, self.coeffs
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
@@ -255,8 +261,12 @@ class BodyLaw:
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
         if co.has_counter_surface:  # exp(q s(u)), u = x − y (``levels.counter_surface``)
-            su, su_x, su_y = counter_surface(x, y)
             qH, qc = co.counter_H_bar, co.counter_c2
+            if xc is None:
+                su, su_x, su_y = counter_surface(x, y)
+            else:  # u = xc − y moves with a only: every slope in the y slot
+                su, su_x, su_y = counter_surface(np.asarray(xc, dtype=float), y)
+                su_x, su_y = 0.0, su_x + su_y
             p, c = p * np.exp(qH * su), c * np.exp(qc * su)
             dp_x, dp_y = dp_x + qH * su_x, dp_y + qH * su_y
             dc_x, dc_y = dc_x + qc * su_x, dc_y + qc * su_y

@@ -196,17 +196,19 @@ class UnifiedPair:
         # curvature ratios z_i = R_i/ρ_i,H − 1 of the collapse limits, ρ_i,H = E'_i R*/E*
         # (Hertz partition; constants of the pair, so the κ root stays unique)
         self._z = {}
+        self._inv_rho_h = {}  # 1/ρ_H of each body: the counter-surface ratio a/ρ_H (``_body``)
         for law, s_, s_o in ((self.law1, s1, s2), (self.law2, s2, s1)):
             if law is None:
                 continue
             rho_h = self.R_star if s_o.is_rigid else s_.material.E_prime * self.R_star / self.E_star
             self._z[id(law)] = curvature_ratio(s_.radius, rho_h)
+            self._inv_rho_h[id(law)] = 1.0 / rho_h
 
     # ------------------------------------------------------------------ body responses
     def _body(self, law: BodyLaw, a, k, R) -> BodyResponse:
         x = a * k
         y = x if self._ratio_rho else a / R
-        return law.response(x, y, self._z[id(law)])
+        return law.response(x, y, self._z[id(law)], a * self._inv_rho_h[id(law)])
 
     def _g(self, a, u, C=0.0, uA=0.0):
         """g = ln p_1 − ln p_2 + C (u − u_A) at (a, u), its u-derivative, and both responses

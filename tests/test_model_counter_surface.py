@@ -152,3 +152,33 @@ def test_calibration_form_fits_them_with_exact_jacobian_columns():
         np.testing.assert_allclose(J[:, j], (res(xj) - res(x)) / 1e-7, atol=1e-5)
     # the a/ρ variant of the form has no such terms (u would be 0)
     assert replace(form, ratio="a_over_rho").n_params == form.n_params - 2
+
+
+def test_pairs_stay_consistent_and_monotone_with_the_counter_terms():
+    """The counter-surface terms of a deformable pair read u = a/ρ_H − a/R (the Hertz partition,
+    a constant of the pair), not the κ solve's ρ: with ρ their negative slope in a/ρ made the κ
+    equation lose its single root, and for this EPP pair the model returned h₁ + h₂ = 0.102 for
+    h = 0.13 and a force that fell from 0.90 to 0.77 between h = 0.125 and 0.13."""
+    import numpy as np
+
+    from spherecontact.model import Material, Sphere, contact, load_coefficients
+
+    co = load_coefficients()
+    assert co.has_counter_surface
+    s1 = Sphere(1.0, Material(E=1400.24, nu=0.3227, sigma_y=1.0))
+    s2 = Sphere(0.53612, Material(E=499.896, nu=0.3, sigma_y=1.48226))
+    h = np.linspace(0.01, 0.3 * 0.53612, 200)
+    st = contact(s1, s2, h, co)
+    np.testing.assert_allclose(st.h1 + st.h2, h, rtol=1e-9)
+    assert np.all(np.diff(st.F) > 0.0) and np.all(np.diff(st.a) > 0.0)
+    rng = np.random.default_rng(7)
+    for _ in range(25):  # random plastic pairs inside the calibrated range of h/R
+        E = 10 ** rng.uniform(1.5, 4)
+        m1 = Material(E=E, nu=rng.uniform(0.2, 0.45), sigma_y=1.0, K=rng.choice([0.0, 2.0]), n=0.3)
+        m2 = Material(E=E * 10 ** rng.uniform(-0.5, 0.5), nu=rng.uniform(0.2, 0.45),
+                      sigma_y=10 ** rng.uniform(-0.5, 0.5), K=m1.K, n=0.3)
+        s2 = Sphere(10 ** rng.uniform(-0.6, 0.6), m2)
+        h = min(1.0, s2.radius) * np.geomspace(1e-5, 0.3, 120)
+        st = contact(Sphere(1.0, m1), s2, h, co)
+        np.testing.assert_allclose(st.h1 + st.h2, h, rtol=1e-9)
+        assert np.all(np.diff(st.F) > 0.0)
