@@ -102,6 +102,9 @@ _PIECES = 1 << 32
 #: relative slack of the domain checks (the domain end of a general pair is found to ~1e-12,
 #: the inversion h → a is exact to ~1e-14)
 _DOMAIN_SLACK = 1.0 + 1e-9
+#: largest |h1 + h2 − h|/h a state from the inversion may have (it is ~1e-14 where the κ root is
+#: unique; a larger gap means the root jumped: ``state_from_h`` raises instead of returning it)
+_CONSISTENT = 1e-8
 #: sections per pass and passes of the search for the domain end of a general pair
 _DOMAIN_SECTIONS = 64
 _DOMAIN_PASSES = 6
@@ -415,7 +418,16 @@ class UnifiedPair:
         forward evaluation."""
         self.check_approach(h)
         a, u = self._invert(h)
-        return self.state_at_a(a, u)
+        st = self.state_at_a(a, u)
+        h = np.asarray(h, dtype=float)
+        off = np.abs(st.h - h) > _CONSISTENT * h
+        if np.any(off):
+            raise ValueError(
+                f"the two-body partition (kappa solve) has no consistent root at h = {_values(h[off])}: "
+                f"the state found gives h1 + h2 = {_values(st.h[off])} ({self.describe()}); the "
+                "model is not defined there for this pair (two nearly fully plastic bodies whose "
+                "pressures no longer depend on the partition)")
+        return st
 
     # ------------------------------------------------------------------ domain
     def check_approach(self, h, name: str = "h") -> None:

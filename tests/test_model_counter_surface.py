@@ -182,3 +182,20 @@ def test_pairs_stay_consistent_and_monotone_with_the_counter_terms():
         st = contact(Sphere(1.0, m1), s2, h, co)
         np.testing.assert_allclose(st.h1 + st.h2, h, rtol=1e-9)
         assert np.all(np.diff(st.F) > 0.0)
+
+
+def test_an_inconsistent_partition_is_an_error_not_a_value():
+    """Beyond h/R ≈ 0.37 two elastic–perfectly plastic spheres whose pressures no longer depend
+    on the partition can leave the κ equation without a single root: the state found then has
+    h₁ + h₂ ≠ h. The model raises, naming the approach, instead of returning it."""
+    import numpy as np
+    import pytest
+
+    from spherecontact.model import Material, Sphere, contact
+
+    s1 = Sphere(1.0, Material(E=3977.0, nu=0.3, sigma_y=1.0))
+    s2 = Sphere(0.689, Material(E=2066.0, nu=0.3, sigma_y=1.38))
+    ok = contact(s1, s2, 0.689 * np.linspace(0.01, 0.3, 100))  # inside the calibrated h/R
+    np.testing.assert_allclose(ok.h1 + ok.h2, 0.689 * np.linspace(0.01, 0.3, 100), rtol=1e-9)
+    with pytest.raises(ValueError, match=r"no consistent root at h = 0\.27"):
+        contact(s1, s2, 0.689 * np.linspace(0.01, 0.5, 400))
