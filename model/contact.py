@@ -40,40 +40,37 @@ class ContactState(NamedTuple):
     rho2: np.ndarray
 
 
-def as_approach(h) -> np.ndarray:
-    """Validate an approach argument: real, finite numbers (any shape)."""
+def _real_array(x, what: str, allow_bool: bool) -> np.ndarray:
+    """``x`` as a float array (no copy of a float array: read only here) of real, finite
+    numbers; ValueError naming ``what`` otherwise."""
     try:
-        arr = np.asarray(h)
+        arr = np.asarray(x)
     except Exception as err:  # ragged sequences and the like
-        raise ValueError(f"h must be a real number or array of real numbers ({err})") from err
+        raise ValueError(f"{what} must be a real number or array of real numbers ({err})") from err
     if arr.dtype == object or not (np.issubdtype(arr.dtype, np.integer)
                                    or np.issubdtype(arr.dtype, np.floating)
-                                   or arr.dtype == bool):
-        raise ValueError(f"h must be a real number or a real array, got dtype {arr.dtype}")
-    arr = arr.astype(float, copy=False)  # no copy of a float array: read only here
+                                   or (allow_bool and arr.dtype == bool)):
+        raise ValueError(f"{what} must be a real number or a real array, got dtype {arr.dtype}")
+    arr = arr.astype(float, copy=False)
     if not np.isfinite(arr).all():
-        raise ValueError("h must be finite (no NaN or inf)")
+        raise ValueError(f"{what} must be finite (no NaN or inf)")
     return arr
+
+
+def as_approach(h) -> np.ndarray:
+    """Validate an approach argument: real, finite numbers (any shape)."""
+    return _real_array(h, "h", allow_bool=True)
 
 
 def as_history(h_max, shape: tuple[int, ...], name: str = "h_max") -> np.ndarray:
     """Validate the largest approach reached: real, finite, ≥ 0, a scalar or shaped like the
     approaches (``shape``); returned with that shape."""
-    try:
-        arr = np.asarray(h_max)
-    except Exception as err:
-        raise ValueError(f"{name} (largest approach reached) must be a real number or array ({err})") from err
-    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.integer)
-                                   or np.issubdtype(arr.dtype, np.floating)):
-        raise ValueError(f"{name} (largest approach reached) must be real, got dtype {arr.dtype}")
-    arr = arr.astype(float, copy=False)
+    what = f"{name} (largest approach reached)"
+    arr = _real_array(h_max, what, allow_bool=False)
     if arr.ndim and arr.shape != tuple(shape):
-        raise ValueError(f"{name} (largest approach reached) must be a scalar or shaped like h "
-                         f"{tuple(shape)}, got shape {arr.shape}")
-    if not np.isfinite(arr).all():
-        raise ValueError(f"{name} (largest approach reached) must be finite (no NaN or inf)")
+        raise ValueError(f"{what} must be a scalar or shaped like h {tuple(shape)}, got shape {arr.shape}")
     if arr.size and arr.min() < 0.0:
-        raise ValueError(f"{name} (largest approach reached) must be >= 0, got min {float(arr.min())!r}")
+        raise ValueError(f"{what} must be >= 0, got min {float(arr.min())!r}")
     return arr if arr.shape == tuple(shape) else np.broadcast_to(arr, shape)
 
 

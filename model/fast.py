@@ -622,8 +622,7 @@ class ContactLaw:
             s = np.log(x)
             j = self._index(s)
             t = (s - self._s[j]) * self._inv_ds[j]
-            tab = self.unloading_table
-            vals = [F, a, h1] + [tab[k][j] + t * (tab[k][j + 1] - tab[k][j])
+            vals = [F, a, h1] + [self._un[k][0][j] + t * self._un[k][1][j]
                                  for k in ("recovery", "m", "h1_res")]
             for o, v in zip(out, vals, strict=True):
                 o[inside] = v
@@ -701,38 +700,14 @@ class ContactLaw:
                 F[pos], k[pos] = self.force(h[pos])
         return F, k
 
-    def _unload_force(self, h, hm):
-        """F and dF/dh on the unloading branches of peaks at hm > h, all inside the table (the
-        hot path: one lookup, the peak's ln F, linear recovery and exponent, two exponentials)."""
-        s = np.log(hm)
-        j = self._index(s)
-        t = (s - self._s[j]) * self._inv_ds[j]
-        c = self._cF[j]
-        ln_Fmax = c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
-        r0, dr = self._un["recovery"]
-        m0, dm = self._un["m"]
-        rec = r0[j] + t * dr[j]
-        m = m0[j] + t * dm[j]
-        delta = rec * hm
-        xi = (h - hm) / delta + 1.0
-        on = xi > 0.0
-        lx = np.log(np.where(on, xi, 1.0))
-        k = np.exp(ln_Fmax + (m - 1.0) * lx) * on
-        F = k * np.where(on, xi, 0.0)
-        k *= m / delta
-        elastic = hm <= self._h_elastic
-        if elastic.any():  # an elastic peak returns along the loading curve
-            e = elastic & (h > 0.0)
-            F[elastic], k[elastic] = 0.0, 0.0
-            if e.any():
-                F[e], k[e] = self.force(h[e])
-        return F, k
-
     def _unload(self, h, hm, full: bool = False):
         """F and dF/dh (and a, h1 if ``full``) on the unloading branches of peaks at hm > h;
-        an elastic peak (recovery 1) returns along the loading curve."""
-        if not full and hm.min() >= self.h_min and hm.max() <= self.h_max:
-            return self._unload_force(h, hm)
+        an elastic peak (recovery 1) returns along the loading curve. F and dF/dh alone come
+        from :meth:`_force_history` where the table holds the peaks."""
+        if not full:
+            fast = self._force_history(h, hm)
+            if fast is not None:
+                return fast
         F_max, a_max, h1_max, rec, m, h1r = self._peaks(hm)
         delta = rec * hm
         xi = np.clip((h - hm + delta) / delta, 0.0, 1.0)
@@ -773,13 +748,7 @@ class ContactLaw:
                     self._report(found)
                 F, k = F.reshape(hh.shape), k.reshape(hh.shape)
                 return (F[()], k[()]) if hh.ndim == 0 else (F, k)
-            below = flat < hm
-            if not below.any():
-                return self.force(h)
-            if below.all():
-                F, k = self._unload(flat, hm)
-                F, k = F.reshape(hh.shape), k.reshape(hh.shape)
-                return (F[()], k[()]) if hh.ndim == 0 else (F, k)
+            below = flat < hm  # some contact needs the exact solve: loading and unloading apart
             F = np.zeros(flat.shape)
             k = np.zeros(flat.shape)
             F[below], k[below] = self._unload(flat[below], hm[below])

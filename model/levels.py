@@ -279,13 +279,21 @@ def counter_surface(x, y):
 ONSET = 1e-3
 
 
-def onset_Lambda(coeffs: Coefficients) -> float:
-    """Λ where the level weight s = 3t² − 2t³ reaches ``ONSET`` (t by fixed-point iteration of
-    t = √((ONSET + 2t³)/3), which converges in a few steps for small ONSET)."""
+def _onset_t() -> float:
+    """t where the level weight s = 3t² − 2t³ reaches ``ONSET``: fixed-point iteration of
+    t = √((ONSET + 2t³)/3), which converges in a few steps for small ONSET."""
     t = math.sqrt(ONSET / 3.0)
     for _ in range(20):
         t = math.sqrt((ONSET + 2.0 * t**3) / 3.0)
-    return coeffs.Lambda_I * (coeffs.Lambda_III / coeffs.Lambda_I) ** t
+    return t
+
+
+_ONSET_T = _onset_t()
+
+
+def onset_Lambda(coeffs: Coefficients) -> float:
+    """Λ where the level weight reaches ``ONSET``: Λ_I (Λ_III/Λ_I)^t_on, t_on of ``_onset_t``."""
+    return coeffs.Lambda_I * (coeffs.Lambda_III / coeffs.Lambda_I) ** _ONSET_T
 
 
 def onset_ramp(Lambda, coeffs: Coefficients) -> np.ndarray:

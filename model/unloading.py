@@ -28,7 +28,7 @@ more conforming residual profile). The law here (``UnloadingCoefficients``):
 * h_res = r · max(h_max − δ_e, 0), r the onset ramp of the body further into plasticity
   (``levels.onset_ramp``: 0 in Level I, 1 once its level weight reaches ``levels.ONSET`` = 10⁻³,
   linear in ln Λ between): an elastic peak leaves no residual approach. Such a peak unloads
-  along the loading curve itself (no hysteresis; :func:`elastic_peak`);
+  along the loading curve itself (no hysteresis; ``Peak.plastic`` False);
 * each body's residual approach (its share of the residual dent): h_res,i ∝ max(h_i −
   δ_e C_i/C, 0), scaled so that they add up to h_res.
 
@@ -48,7 +48,7 @@ from .levels import onset_ramp
 from .unified import UnifiedPair, UnifiedState
 
 __all__ = ["EXPONENT_RANGE", "Peak", "PeakFeatures", "features", "peak_features",
-           "unloading_law", "peak_parameters", "elastic_peak", "branch", "work_returned"]
+           "unloading_law", "peak_parameters", "branch", "work_returned"]
 
 # ``levels.ONSET``: the level weight at which the residual approach has grown from 0 (Level I)
 # to the law's value (FE cycles at weights 1e-4 / 1e-3 / 4e-3 left 0 / 4 / 3 % of h_max;
@@ -152,11 +152,6 @@ def peak_parameters(p: UnifiedPair, st: UnifiedState, law: UnloadingCoefficients
     return Peak(h_max=st.h, F_max=st.F, a_max=st.a, m=m, delta_e=delta_e, h_res=h_res,
                 h1_max=st.h1, h2_max=st.h2, h1_res=h1_res, h2_res=h_res - h1_res,
                 plastic=f.onset > 0.0)
-
-
-def elastic_peak(pk: Peak) -> np.ndarray:
-    """True where the peak stayed in Level I: the branch is the loading curve itself."""
-    return ~pk.plastic
 
 
 class Branch(NamedTuple):

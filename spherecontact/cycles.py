@@ -4,10 +4,10 @@ A run with cycles (``fem.io``: ``cycles/*``, ``curves/branch``) holds per unload
 its peak (h_max, F_max, a_max; the increments of the peak and of the end) and the branch
 F(h) down to the residual approach h_res. :func:`run_cycles` turns each into an
 :class:`UnloadingCurve`: the branch as F/F_max at the FE's approaches and the peak as the
-law's ``PeakFeatures`` — F, a, each body's approach h_i and the curvature κ of the contact
-surface from the FE; only the onset ramp comes from the model (the loading coefficients' Λ
-at the FE's a_max, ``levels.onset_ramp``). Calibration fits the law to these; validation
-scores it on them (:func:`branch_errors`).
+law's ``PeakFeatures`` (``unloading.peak_features``, as the model reads its own peaks) — F, a,
+each body's approach h_i and the curvature κ of the contact surface from the FE; only the
+onset ramp comes from the model (the loading coefficients' Λ at the FE's a_max). Calibration
+fits the law to these; validation scores it on them (:func:`branch_errors`).
 """
 
 from __future__ import annotations
@@ -19,11 +19,10 @@ import numpy as np
 
 from .fem.io import spheres_from_inputs
 from .model.coefficients import Coefficients, UnloadingCoefficients
-from .model.levels import onset_ramp
 from .model.unified import pair
-from .model.unloading import PeakFeatures, features, unloading_law
+from .model.unloading import PeakFeatures, peak_features, unloading_law
 
-__all__ = ["UnloadingCurve", "run_cycles", "branch_errors", "law_residuals", "joined"]
+__all__ = ["UnloadingCurve", "run_cycles", "branch_errors", "law_branch", "law_residuals", "joined"]
 
 #: FE scenes of the runs → the model's scene (``fem.io.spheres_from_inputs``)
 _SCENES = {"rigid_flat": "flat", "rigid_sphere": "rigid_sphere", "two_body": "two_body",
@@ -65,26 +64,21 @@ def run_cycles(name: str, run, coeffs: Coefficients) -> list[UnloadingCurve]:
     if scene == "equal_pair_symmetry":
         s2 = s1
     p = pair(s1, s2, coeffs)
-    comp = [0.0 if s.is_rigid else 1.0 / s.material.E_prime for s in (s1, s2)]
-    nu = [s.material.nu for s in (s1, s2)]
-    radius = [s.radius for s in (s1, s2)]
     R = min(s.radius for s in (s1, s2) if not s.is_rigid)
     h, F = np.asarray(run.curves["h"], dtype=float), np.asarray(run.curves["F"], dtype=float)
-    a_max = np.asarray(cyc["a_max"], dtype=float)
-    st = p.state_at_a(a_max)
-    weight = np.zeros_like(a_max)
-    for s, Lam in ((s1, st.Lambda1), (s2, st.Lambda2)):
-        if not s.is_rigid and math.isfinite(s.material.sigma_y):
-            weight = np.maximum(weight, onset_ramp(Lam, coeffs))
-    out = []
-    for k in range(len(a_max)):
-        i0, i1 = int(cyc["increment_peak"][k]), int(cyc["increment_end"][k])
-        hm, Fm = float(cyc["h_max"][k]), float(cyc["F_max"][k])
-        h_i, kappa = _peak_values(run, scene, i0)
-        pk = features([hm], [Fm], [a_max[k]], [h_i], comp, nu, radius, [kappa], p.R_star, [weight[k]])
-        out.append(UnloadingCurve(name=f"{name} cycle {k + 1}", h=h[i0:i1 + 1], f=F[i0:i1 + 1] / Fm,
-                                  h_max=hm, h_res=float(cyc["h_res"][k]), R=R, peak=pk))
-    return out
+    peak, end = np.asarray(cyc["increment_peak"], dtype=int), np.asarray(cyc["increment_end"], dtype=int)
+    h_max, F_max = np.asarray(cyc["h_max"], dtype=float), np.asarray(cyc["F_max"], dtype=float)
+    h_i, kappa = zip(*(_peak_values(run, scene, i) for i in peak), strict=True)
+    h_i = np.array(h_i)
+    # the model's state at the FE's contact radii (its Λ: the onset ramp) carrying the FE's peak
+    st = p.state_at_a(np.asarray(cyc["a_max"], dtype=float))._replace(
+        h=h_max, F=F_max, h1=h_i[:, 0], h2=h_i[:, 1], kappa=np.array(kappa))
+    peaks = peak_features(p, st)
+    return [UnloadingCurve(name=f"{name} cycle {k + 1}", h=h[peak[k]:end[k] + 1],
+                           f=F[peak[k]:end[k] + 1] / F_max[k], h_max=float(h_max[k]),
+                           h_res=float(cyc["h_res"][k]), R=R,
+                           peak=PeakFeatures(*(v[k:k + 1] for v in peaks)))
+            for k in range(h_max.size)]
 
 
 def joined(curves) -> tuple[PeakFeatures, np.ndarray]:
@@ -95,10 +89,18 @@ def joined(curves) -> tuple[PeakFeatures, np.ndarray]:
     return peaks, idx
 
 
-def law_residuals(law: UnloadingCoefficients, peaks: PeakFeatures, idx, h, f):
+def law_branch(law: UnloadingCoefficients, peaks: PeakFeatures, idx, h):
+    """F/F_max of ``law`` at the approaches h of the branches ``idx`` of ``peaks``, and each
+    peak's residual approach."""
     m, delta_e, h_res, _ = unloading_law(peaks, law)
     xi = np.clip((h - h_res[idx]) / delta_e[idx], 0.0, 1.0)
-    return xi ** m[idx] - f, h_res
+    return xi ** m[idx], h_res
+
+
+def law_residuals(law: UnloadingCoefficients, peaks: PeakFeatures, idx, h, f):
+    """:func:`law_branch` − the FE's F/F_max ``f``, and each peak's residual approach."""
+    pred, h_res = law_branch(law, peaks, idx, h)
+    return pred - f, h_res
 
 
 def branch_errors(law: UnloadingCoefficients, curves) -> tuple[np.ndarray, np.ndarray]:

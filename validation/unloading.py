@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..cycles import UnloadingCurve, branch_errors, run_cycles
+from ..cycles import UnloadingCurve, law_branch, run_cycles
 from ..fem.io import spheres_from_inputs
 from ..model import Coefficients, contact, cycle, default_coefficients
 from ..model.coefficients import UnloadingCoefficients
@@ -108,8 +108,6 @@ def _case_rows(case: Case, co: Coefficients, store=None) -> list[UnloadingRow]:
     if not curves:
         return []
     s1, s2 = spheres_from_inputs(case.inputs, scene_of(case.params, case.inputs))
-    law_err, law_hres = branch_errors(co.unloading, curves)
-    th_err, th_hres = branch_errors(UnloadingCoefficients(), curves)
     E_star = 1.0 / sum(0.0 if s.is_rigid else 1.0 / s.material.E_prime for s in (s1, s2))
     R_star = 1.0 / sum(1.0 / s.radius for s in (s1, s2))
     Y, nu = _softer(s1, s2)
@@ -122,8 +120,8 @@ def _case_rows(case: Case, co: Coefficients, store=None) -> list[UnloadingRow]:
         st = contact(s1, s2, c.h, co, h_max=c.h_max)
         f_model = st.F / F_fe_max[k]
         f_ekk, h_res_ekk = ekk_branch(c.h, c.h_max, 1.0, omega_c)
-        f_law = _law_branch(co.unloading, c)
-        f_th = _law_branch(UnloadingCoefficients(), c)
+        f_law, h_res_law = _law_branch(co.unloading, c)
+        f_th, h_res_th = _law_branch(UnloadingCoefficients(), c)
         w_in = float(case.cycles["work_in"][k]) if "work_in" in case.cycles else math.nan
         w_ret = float(case.cycles["work_returned"][k]) if "work_returned" in case.cycles else math.nan
         first = k == 0
@@ -139,11 +137,12 @@ def _case_rows(case: Case, co: Coefficients, store=None) -> list[UnloadingRow]:
             branches["LAMMPS mdr"] = f_mdr
         rows.append(UnloadingRow(
             run=case.label, key=case.key, cycle=k + 1, h_over_R=c.h_max / c.R, h_res_fe=c.h_res / c.h_max,
-            F_err={"law": float(law_err[k]), "model": _branch_error(f_model, c),
-                   "Thornton 1997": float(th_err[k]), "Etsion et al. 2005": _branch_error(f_ekk, c), **F_err},
-            h_res_err={"law": float(law_hres[k]),
+            F_err={"law": _branch_error(f_law, c), "model": _branch_error(f_model, c),
+                   "Thornton 1997": _branch_error(f_th, c), "Etsion et al. 2005": _branch_error(f_ekk, c),
+                   **F_err},
+            h_res_err={"law": abs(h_res_law - c.h_res) / c.h_max,
                        "model": abs(float(cyc_model.h_res[k]) - c.h_res) / c.h_max,
-                       "Thornton 1997": float(th_hres[k]),
+                       "Thornton 1997": abs(h_res_th - c.h_res) / c.h_max,
                        "Etsion et al. 2005": abs(h_res_ekk - c.h_res) / c.h_max, **h_err},
             e_fe=math.sqrt(max(w_ret / w_in, 0.0)) if first and w_in > 0 else math.nan,
             e_model=float(cyc_model.restitution[k]) if first else math.nan,
@@ -153,13 +152,10 @@ def _case_rows(case: Case, co: Coefficients, store=None) -> list[UnloadingRow]:
     return rows
 
 
-def _law_branch(law: UnloadingCoefficients, c: UnloadingCurve) -> np.ndarray:
-    """F/F_max of ``law`` given the FE's peak at the branch's approaches."""
-    from ..model.unloading import unloading_law
-
-    m, delta_e, h_res, _ = unloading_law(c.peak, law)
-    xi = np.clip((c.h - h_res[0]) / delta_e[0], 0.0, 1.0)
-    return xi ** m[0]
+def _law_branch(law: UnloadingCoefficients, c: UnloadingCurve) -> tuple[np.ndarray, float]:
+    """F/F_max of ``law`` given the FE's peak at the branch's approaches, and its h_res."""
+    f, h_res = law_branch(law, c.peak, np.zeros(c.h.size, dtype=int), c.h)
+    return f, float(h_res[0])
 
 
 def unloading_rows(cases: list[Case], coeffs: Coefficients | None = None, mdr=None) -> list[UnloadingRow]:
