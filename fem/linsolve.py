@@ -41,10 +41,14 @@ REGULARISATION = 1e-10
 REFINEMENTS = 3
 
 
+def superlu_factor(K: sp.spmatrix):
+    """SuperLU factors of K (MMD on Kᵀ + K, symmetric mode: diagonal pivots preferred)."""
+    return spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+
+
 def superlu_solve(K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
-    """x with K x = b by SuperLU (MMD on Kᵀ + K, symmetric mode: diagonal pivots preferred)."""
-    lu = spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
-    return lu.solve(b)
+    """x with K x = b by SuperLU (:func:`superlu_factor`)."""
+    return superlu_factor(K).solve(b)
 
 
 class SymmetricSolver:
@@ -69,6 +73,17 @@ class SymmetricSolver:
         self._last = None  # (indptr, indices, positions in the stored pattern) of the last matrix
         self.stats = {"ldl_fresh": 0, "ldl_update": 0, "fallback": 0, "superlu": 0}
         self.times = {"factorisation": 0.0, "solve": 0.0}
+        self._reuse = None  # solve() of the factors that gave the last accepted solution
+
+    def resolve(self, b: np.ndarray) -> np.ndarray | None:
+        """x with K x = b for the matrix of the last accepted solution, on its stored factors
+        (no refactorisation, no check); None when no solution has been accepted yet."""
+        if self._reuse is None:
+            return None
+        t0 = time.perf_counter()
+        x = self._reuse(np.asarray(b, dtype=float))
+        self.times["solve"] += time.perf_counter() - t0
+        return x
 
     def _factor(self, K: sp.csc_matrix) -> None:
         """Factor K. The stored pattern only grows: a matrix whose entries lie inside it is
@@ -185,17 +200,20 @@ class SymmetricSolver:
                 ok = np.all(np.isfinite(x)) and np.abs(matvec(x) - b).max(initial=0.0) <= self.rtol * scale
                 self.times["solve"] += time.perf_counter() - t1
                 if ok:
+                    self._reuse = self._solver.solve
                     return x
             except (ValueError, RuntimeError):
                 # not reused after a failure
                 self._solver, self._pattern, self._keys, self._last = None, None, None, None
+            self._reuse = None
             self.stats["fallback"] += 1
             t0 = time.perf_counter()
         else:
             self.stats["superlu"] += 1
-        x = superlu_solve(full(), b)
+        lu = superlu_factor(full())
         self.times["factorisation"] += time.perf_counter() - t0
-        return x
+        self._reuse = lu.solve
+        return lu.solve(b)
 
 
 class ConstrainedPattern:

@@ -7,7 +7,8 @@ curve): the systematic difference is the median of ln(new/stored), the largest o
 maximum, beside the stored curve's own FE scatter (max |ln y − local quadratic| over 11
 increments). Two noisy curves may differ by up to the sum of their scatters.
 
-``python -m spherecontact.fem.reproduce --out reports/fem`` → ``reproduce.json``.
+``python -m spherecontact.fem.reproduce --out reports/fem`` → ``reproduce.json`` (``--cases``
+re-runs some cases and keeps the others' earlier rows).
 """
 
 from __future__ import annotations
@@ -62,7 +63,11 @@ def main(argv: list[str] | None = None) -> int:
               f"{row['wall_s_new']:.0f} s (stored {row['wall_s_stored']:.0f} s)", flush=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "reproduce.json").write_text(json.dumps(results, indent=1) + "\n")
+    path = out / "reproduce.json"
+    earlier = json.loads(path.read_text()) if path.exists() else []
+    rerun = {row["case"] for row in results}
+    kept = [row for row in earlier if row["case"] not in rerun]  # cases not re-run this time
+    path.write_text(json.dumps(kept + results, indent=1) + "\n")
     return 0
 
 

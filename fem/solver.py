@@ -5,10 +5,12 @@ the origin, equatorial plane z = R); the equatorial plane is moved towards the
 obstacle by h (u_z = −h, free to slide radially), the axis has u_r = 0, the arc
 meets a rigid flat or rigid sphere in frictionless contact (``contact.py``).
 
-Each increment: secant predictor, then Newton on the free dofs with the exact
-tangent (material ∂P/∂F by complex step, plus the rigid sphere's curvature
-term), the contact active set updated in the same loop (primal–dual active
-set: release on tensile reaction, close on penetration). With
+Each increment: tangent predictor (the last converged increment's factorised
+tangent applied to the new approach step; the secant of the last two increments
+where that is not at hand), then Newton on the free dofs with the exact tangent
+(material ∂P/∂F linearised by hand, plus the rigid sphere's curvature term),
+the contact active set updated in the same loop (primal–dual active set:
+release on tensile reaction, close on penetration). With
 ``SolverOptions.penalty`` the contact is a penalty instead: every penetrating
 node carries k_N A_i (−g_i) along the obstacle normal (Wriggers 2006, §5.2),
 with no constrained dof; it exists to show what the exact method avoids. Increments grow after
@@ -97,6 +99,10 @@ class SolverOptions:
     penalty: float | None = None
     #: "ldl": qdldl LDLᵀ reusing its symbolic analysis, SuperLU where it fails; "superlu": SuperLU only
     linear_solver: str = "ldl"
+    #: "tangent": the last converged increment's factorised tangent applied to the new approach
+    #: step (:meth:`IndentationSolver._tangent_predictor`), the secant where it is not at hand;
+    #: "secant": the last increment's displacement change extrapolated
+    predictor: str = "tangent"
     #: 0: penalty at the nodes; n > 0: penalty pressure integrated at n Gauss points per surface
     #: edge (segment_penalty.py), which needs ``penalty``
     segment_points: int = 0
@@ -143,6 +149,8 @@ class SolverOptions:
                              f"{self.unload_increments!r}")
         if self.linear_solver not in ("ldl", "superlu"):
             raise ValueError(f"linear_solver must be 'ldl' or 'superlu', got {self.linear_solver!r}")
+        if self.predictor not in ("tangent", "secant"):
+            raise ValueError(f"predictor must be 'tangent' or 'secant', got {self.predictor!r}")
         if self.penalty is not None and not (isinstance(self.penalty, (int, float))
                                              and np.isfinite(self.penalty) and self.penalty > 0):
             raise ValueError(f"penalty must be None (exact contact) or a finite number > 0, "
@@ -733,6 +741,8 @@ class IndentationSolver(CycleLegs):
         self._upper = ConstrainedPattern(*self.disc.csr_pattern)
         self._nd = nd
         self.k_penalty = None
+        self._tangent = None  # (K, fixed dofs, their diagonal value, nodal frames) of the last solve
+        self._tangent_ready = False  # _tangent belongs to the last converged increment
         if self.options.penalty is not None:
             x_arc = self.X[:, self.arc]
             pole_edge = float(np.hypot(*(x_arc[:, 2] - x_arc[:, 0])))
@@ -909,6 +919,7 @@ class IndentationSolver(CycleLegs):
             rhs[fixed] = scale * du_c[fixed]
             U, diag = self._upper.upper(data, fixed, scale)
             du = self.linear.solve_upper(U, diag, rhs, self._upper)
+            self._tangent = (K, fixed, scale, frames)
             du[fixed] = du_c[fixed]
             du = self._rotate(du, frames)
             t6 = time.perf_counter()
@@ -971,11 +982,15 @@ class IndentationSolver(CycleLegs):
         dh = h_new - run.h
         if self.options.penalty_scale == "approach" and h_new > run.h_top:
             self._approach_stiffness(run, h_new)
+        tangent_ready, self._tangent_ready = self._tangent_ready, False
+        u_pred = None
         if run.u_prev is None:  # first increment, or the first after a reversal
             u_pred = run.u.copy()
             if run.h == 0.0:  # rigid translation by dh/2: its intersection radius √(R dh) is Hertz's a
                 u_pred[1::2] -= 0.5 * dh
-        else:  # secant predictor
+        elif tangent_ready and self.options.predictor == "tangent":
+            u_pred = self._tangent_predictor(run.u, dh)
+        if u_pred is None:  # secant predictor
             u_pred = run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
         u_pred[2 * self.hmesh.equator + 1] = -h_new
         u_pred[2 * self.hmesh.axis] = 0.0
@@ -984,6 +999,28 @@ class IndentationSolver(CycleLegs):
         except (IncrementFailed, RuntimeError, np.linalg.LinAlgError) as err:
             self.rejected.append((h_new, dh, str(err)))
             return err
+
+    def _tangent_predictor(self, u: np.ndarray, dh: float) -> np.ndarray | None:
+        """u + Δu with K Δu = 0 on the free dofs and Δu_z = −dh on the equator: the step the
+        last converged increment's tangent K (its last factorisation, reused: one pair of
+        triangular solves) gives for the next approach step, the active contact nodes held on
+        the obstacle. None when that factorisation is not at hand.
+
+        The secant predictor extrapolates the last increment's displacement change, which
+        carries the jump of every surface node that closed in it; the tangent carries the
+        present contact set only. Standard run (EPP E/σY 200, flat, h/R 0.3): 1097 → 993
+        Newton iterations; rigid sphere 2R: 1031 → 951 (both side by side on two cores).
+        """
+        K, fixed, scale, frames = self._tangent
+        du_c = np.zeros(self._nd)
+        du_c[2 * self.hmesh.equator + 1] = -dh
+        rhs = -(K @ du_c)
+        rhs[fixed] = scale * du_c[fixed]
+        du = self.linear.resolve(rhs)
+        if du is None or not np.all(np.isfinite(du)):
+            return None
+        du[fixed] = du_c[fixed]
+        return u + self._rotate(du, frames)
 
     def _approach_stiffness(self, run: _RunState, h_new: float) -> None:
         """k_N = penalty · p_m / h for a loading increment to ``h_new`` (penalty_scale "approach").
@@ -1045,6 +1082,7 @@ class IndentationSolver(CycleLegs):
         """Record a converged increment and make it the run's state."""
         hist = self._hist
         u_new, upd, act, its, changes, res_hist, f, gap, lam, normal = solved
+        self._tangent_ready = self._tangent is not None
         state = run.state
         diss_inc = plastic_dissipation(self.disc, self.material, state.eps_p, upd.dgamma)
         run.state = PlasticState(upd.cp_inv, upd.eps_p, state.dissipation + diss_inc)
@@ -1122,6 +1160,7 @@ class IndentationSolver(CycleLegs):
         for k in self.timers:
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(opt.linear_solver)
+        self._tangent, self._tangent_ready = None, False
         self.rejected = []
         self.plastic_frozen_increments = 0
         self.backed_up_increments = 0

@@ -38,6 +38,9 @@ from .contact import RigidObstacle
 from .solver import IndentationSolver, SolverOptions
 
 NU = 0.3
+#: issue "FE reference v2": the standard run's wall time alone and its Newton iterations per increment
+STANDARD_WALL_LIMIT_S = 25.0
+MAX_ITERATIONS_PER_INCREMENT = 5.0
 
 
 def _run(kind: str, E_over_sy: float, h_max: float, density: float = 1.0, element: str = "q8r",
@@ -339,8 +342,9 @@ def _report(figures: dict, pngs: list[str], outdir: Path, wall: float, quick: bo
         lines.append(f"| half strain increment at {key} | — | F {100 * v['F_rel_diff']:+.2f} %, "
                      f"a {100 * v['a_rel_diff']:+.2f} % | — |")
     n = figures["newton"]
-    lines.append(f"| Newton rate (log r_k+1 / log r_k) | 2 | median {n['quadratic_rate_median']:.2f}, "
-                 f"{n['iterations_per_increment']:.1f} it/increment | — |")
+    lines.append(f"| Newton rate (log r_k+1 / log r_k); iterations per increment | 2; ≤ {MAX_ITERATIONS_PER_INCREMENT:g} | "
+                 f"median {n['quadratic_rate_median']:.2f}, {n['iterations_per_increment']:.2f} it/increment | "
+                 f"{n['iterations_per_increment'] <= MAX_ITERATIONS_PER_INCREMENT} |")
     lk = figures["locking"]
     lines.append(f"| locking, EPP E/σY=10⁴, Λ ≈ {lk['lock_q8r']['Lambda']:.0f} | p_m mesh-converged | "
                  f"Q8R p_m/σY {lk['lock_q8r']['p_m_over_sy']:.3f} → {lk['lock_q8r_fine']['p_m_over_sy']:.3f} "
@@ -350,10 +354,11 @@ def _report(figures: dict, pngs: list[str], outdir: Path, wall: float, quick: bo
     lines.append(f"| energy W = E_el + D (h/R ≥ 0.01) | ≤ 1 % | max {100 * e['balance_rel_err_max_h_ge_0.01']:.2f} %, "
                  f"end {100 * e['balance_rel_err_end']:+.2f} % | {e['pass']} |")
     s = figures["speed"]
-    lines.append(f"| standard run EPP 200 to h/R={s['h_max']:g} | < 30 s | {s['wall_s']:.1f} s "
+    lines.append(f"| standard run EPP 200 to h/R={s['h_max']:g} (the other core busy here; alone: `make bench`) "
+                 f"| ≤ {STANDARD_WALL_LIMIT_S:g} s | {s['wall_s']:.1f} s "
                  f"({s['increments']} increments, {s['newton_iterations']} iterations; constitutive "
                  f"{s['constitutive_s']:.1f} s, assembly {s['assembly_s']:.1f} s, solve {s['solve_s']:.1f} s) | "
-                 f"{s['wall_s'] < 30} |")
+                 f"{s['wall_s'] <= STANDARD_WALL_LIMIT_S} |")
     for key, v in figures.get("large", {}).items():
         lines.append(f"| {key} to h/R = 0.5 | reach or say why | {v['status']}: h/R = {v['h_reached']:.3f}, "
                      f"{v['wall_s']:.0f} s; {v['reason']} | {v['status'] == 'converged'} |")

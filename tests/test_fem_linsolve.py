@@ -205,3 +205,27 @@ def test_saddle_and_plain_solves_share_one_solver():
         x = s.solve_saddle(sys_, rhs, m)
         assert np.abs(sys_ @ x - rhs).max() < 1e-10 * np.abs(rhs).max()
     assert s.stats["fallback"] == 0 and s.stats["ldl_fresh"] == 4 and s.stats["ldl_update"] == 1
+
+
+@pytest.mark.parametrize("method", ["ldl", "superlu"])
+def test_resolve_reuses_the_factors_of_the_last_accepted_solution(method):
+    K = _laplacian(12)
+    rng = np.random.default_rng(1)
+    s = SymmetricSolver(method)
+    assert s.resolve(np.ones(K.shape[0])) is None  # nothing factored yet
+    s.solve(K, rng.standard_normal(K.shape[0]))
+    b = rng.standard_normal(K.shape[0])
+    counts = dict(s.stats)
+    assert np.allclose(K @ s.resolve(b), b, rtol=0, atol=1e-10)
+    assert s.stats == counts  # no factorisation
+
+
+def test_resolve_after_a_fallback_uses_superlus_factors():
+    K = _laplacian(8).tolil()
+    K[0, 0] = 0.0  # zero first pivot: LDLᵀ without pivoting breaks down
+    K = K.tocsr()
+    s = SymmetricSolver("ldl")
+    s.solve(K, np.ones(K.shape[0]))
+    assert s.stats["fallback"] == 1
+    b = np.arange(K.shape[0], dtype=float)
+    assert np.allclose(K @ s.resolve(b), b, rtol=0, atol=1e-9)

@@ -115,6 +115,8 @@ def test_default_options_are_valid_and_bad_ones_are_named():
         SolverOptions(max_wall_s=0.0).validate()
     with pytest.raises(ValueError, match="strain_increment"):
         SolverOptions(strain_increment=-1.0).validate()
+    with pytest.raises(ValueError, match="predictor must be 'tangent' or 'secant'"):
+        SolverOptions(predictor="quadratic").validate()
 
 
 def test_wall_time_limit_stops_with_reason_and_keeps_increments():
@@ -257,3 +259,43 @@ def test_smoothness_rerun_of_some_cases_keeps_the_others(tmp_path, monkeypatch):
     out = json.loads((tmp_path / "smoothness.json").read_text())
     assert [r["label"] for r in out] == [c[0] for c in smoothness.CASES]
     assert [r["wall_s"] for r in out] == [2.0 if i == 1 else 1.0 for i in range(len(out))]
+
+
+@pytest.mark.parametrize("indenter", [np.inf, 1.5])
+def test_tangent_predictor_is_the_last_converged_tangents_step(indenter, monkeypatch):
+    """The predictor solves K Δu = 0 on the free dofs with the equator moved by −dh and the
+    active contact dofs held (in their nodal frames on a curved obstacle), on the factors of
+    the last converged increment; without those factors the secant predictor takes over and
+    the run ends at the same state within the path dependence of plasticity."""
+    mat = Material(E=E, nu=NU, sigma_y=1.0)
+    solver = IndentationSolver(mat, 1.0, RigidObstacle(indenter), density=0.5)
+    calls = []
+    predictor = solver._tangent_predictor
+
+    def recorded(u, dh):
+        K, fixed, scale, frames = solver._tangent
+        pred = predictor(u, dh)
+        calls.append((u, dh, pred, K, fixed, frames))
+        return pred
+
+    monkeypatch.setattr(solver, "_tangent_predictor", recorded)
+    res = solver.run(0.01)
+    assert res.status == "converged"
+    assert len(calls) >= res.timings["increments"] - 3  # all but the first increments
+    u, dh, pred, K, fixed, frames = calls[len(calls) // 2]
+    du = solver._rotate(pred - u, frames)  # into the nodal frames of the factored K
+    free = np.ones(du.size, dtype=bool)
+    free[fixed] = False
+    assert np.abs((K @ du)[free]).max() <= 1e-9 * np.abs(K @ du).max()
+    equator_z = 2 * solver.hmesh.equator + 1
+    assert np.allclose(du[equator_z], -dh)
+    assert np.abs(du[np.setdiff1d(fixed, equator_z)]).max() <= 1e-12 * dh  # held on the obstacle
+
+    secant = IndentationSolver(mat, 1.0, RigidObstacle(indenter), density=0.5,
+                               options=SolverOptions(predictor="secant")).run(0.01)
+    fallback = IndentationSolver(mat, 1.0, RigidObstacle(indenter), density=0.5)
+    monkeypatch.setattr(fallback, "_tangent_predictor", lambda u, dh: None)  # factors never at hand
+    fallback = fallback.run(0.01)
+    assert secant.status == fallback.status == "converged"
+    assert np.array_equal(fallback.F, secant.F)
+    assert abs(secant.F[-1] / res.F[-1] - 1) < 5e-3
