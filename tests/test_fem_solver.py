@@ -299,3 +299,36 @@ def test_tangent_predictor_is_the_last_converged_tangents_step(indenter, monkeyp
     assert secant.status == fallback.status == "converged"
     assert np.array_equal(fallback.F, secant.F)
     assert abs(secant.F[-1] / res.F[-1] - 1) < 5e-3
+
+
+def test_a_failed_loading_step_caps_the_next_ones(monkeypatch):
+    """After a failed step the strain step is capped at STEP_SHRINK × the failed size and grows
+    back slowly (× STEP_RECOVERY per easy increment); without the cap (a huge STEP_SHRINK)
+    growth brings the step back to the failed size at once."""
+    import spherecontact.fem.solver as solver_module
+    from spherecontact.fem.solver import STEP_SHRINK, IncrementFailed
+
+    def steps_after_a_failure():
+        solver = IndentationSolver(Material(E=E, nu=NU, sigma_y=1.0), 1.0, density=0.5)
+        solve, failed = solver._solve, []
+
+        def failing_once(run, h_new):
+            if not failed and len(solver._hist.h) == 15:
+                failed.append(h_new - run.h)
+                return IncrementFailed("test")
+            return solve(run, h_new)
+
+        monkeypatch.setattr(solver, "_solve", failing_once)
+        res = solver.run(0.01)
+        assert res.status == "converged" and failed
+        return np.diff(res.h)[14:18] / failed[0]  # increments 0 … 14 came before the failure
+
+    capped = steps_after_a_failure()
+    monkeypatch.setattr(solver_module, "STEP_SHRINK", 1e9)
+    uncapped = steps_after_a_failure()
+    assert capped[0] == uncapped[0] == pytest.approx(0.5)  # halved
+    assert uncapped[1:].max() >= 1.0  # back to the size that failed
+    # the cap binds from the first growth on; once the uncapped step is back at the strain step
+    # the capped one stays at about STEP_SHRINK of it
+    assert np.all(capped[1:] <= uncapped[1:])
+    assert np.all(capped[2:] <= (STEP_SHRINK + 0.05) * uncapped[2:])
