@@ -484,6 +484,7 @@ class TwoBodySolver(CycleLegs):
             self.timers["contact"] += t3 - t2
             du = np.zeros(self.n_dofs)
             du[free] = self.linear.solve(K[free][:, free], -r[free])  # symmetric: LDLᵀ, SuperLU fallback
+            self._tangent = K
             u, known, kins = self._line_search(u, du, f, kins, states, self._penalty_force)
             self.timers["solve"] += time.perf_counter() - t3
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
@@ -536,6 +537,7 @@ class TwoBodySolver(CycleLegs):
         for k in self.timers:
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(self.options.linear_solver)
+        self._tangent, self._tangent_ready = None, False  # penalty contact: K of the last solve
         self.rejected = []
         self.plastic_frozen_increments = 0
         self.backed_up_increments = 0
@@ -593,9 +595,13 @@ class TwoBodySolver(CycleLegs):
     def _solve(self, run: _RunState, h_new: float):
         """Newton for one increment to ``h_new``: the converged tuple, or the exception."""
         dh = h_new - run.h
+        tangent_ready, self._tangent_ready = self._tangent_ready, False
+        u_pred = None
         if run.u_prev is None:  # first increment, or the first after a reversal
             u_pred = self._predictor(dh) if run.h == 0.0 else run.u.copy()
-        else:
+        elif tangent_ready and self.options.predictor == "tangent":
+            u_pred = self._tangent_predictor(run.u, dh)
+        if u_pred is None:  # secant predictor
             u_pred = run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
         u_pred = self._apply_bc(u_pred, h_new)
         try:
@@ -605,9 +611,28 @@ class TwoBodySolver(CycleLegs):
             self.rejected.append((h_new, dh, str(err)))
             return err
 
+    def _tangent_predictor(self, u: np.ndarray, dh: float) -> np.ndarray | None:
+        """u + Δu with K Δu = 0 on the free dofs and body 1's equator moved by −dh, K the last
+        converged increment's tangent on its stored factors (penalty contact: the plain
+        symmetric system; :meth:`IndentationSolver._tangent_predictor`). None when those
+        factors are not at hand (exact contact's saddle-point systems keep the secant)."""
+        if self._tangent is None:
+            return None
+        b1 = self.bodies[0]
+        du_c = np.zeros(self.n_dofs)
+        du_c[b1.offset + 2 * b1.hmesh.equator + 1] = -dh
+        free = self.free
+        x = self.linear.resolve(-(self._tangent @ du_c)[free])
+        if x is None or not np.all(np.isfinite(x)):
+            return None
+        du = du_c
+        du[free] = x
+        return u + du
+
     def _commit(self, run: _RunState, h_new: float, solved, branch: int) -> None:
         """Record a converged increment and make it the run's state."""
         u_new, per_body, f, act, lam_new, gap, normal, its, log, F = solved
+        self._tangent_ready = self._tangent is not None
         states = [PlasticState(upd.cp_inv, upd.eps_p, st.dissipation
                                + plastic_dissipation(b.disc, b.material, st.eps_p, upd.dgamma))
                   for b, st, (_, upd, _) in zip(self.bodies, run.state, per_body, strict=True)]

@@ -93,3 +93,32 @@ def test_two_pass_penalty_keeps_an_equal_pair_symmetric():
     assert np.abs(F[sel] / flat.F[sel] - 1).max() < 0.025
     W = np.trapezoid(c["F"], c["h1"])
     assert abs(W / np.trapezoid(flat.F, flat.h) - 1) < 0.01
+
+
+def test_two_body_penalty_pair_starts_each_increment_from_the_last_tangent(monkeypatch):
+    """Penalty contact of two bodies: the tangent predictor solves K Δu = 0 on the free dofs
+    with body 1's equator moved by −dh, on the stored factors; the secant run ends within
+    the path dependence of plasticity."""
+    from spherecontact.fem.twobody import TwoBodySolver
+
+    calls = []
+    predictor = TwoBodySolver._tangent_predictor
+
+    def recorded(self, u, dh):
+        pred = predictor(self, u, dh)
+        calls.append((u, dh, pred, self._tangent, self.free, self.bodies[0]))
+        return pred
+
+    monkeypatch.setattr(TwoBodySolver, "_tangent_predictor", recorded)
+    stiff = Material(E=600.0, nu=0.3, sigma_y=1.0)
+    kw = dict(radius2=1.0, material2=stiff, density=0.5)
+    res = run_indentation(PLASTIC, 1.0, 0.006, options=SolverOptions(penalty=100.0), **kw)
+    assert res.status == "converged"
+    assert sum(c[2] is not None for c in calls) >= res.timings["increments"] - 3
+    u, dh, pred, K, free, body1 = calls[len(calls) // 2]
+    du = pred - u
+    assert np.abs((K @ du)[free]).max() <= 1e-9 * np.abs(K @ du).max()
+    assert du[body1.offset + 2 * body1.hmesh.equator + 1] == pytest.approx(-dh)
+    secant = run_indentation(PLASTIC, 1.0, 0.006, options=SolverOptions(penalty=100.0, predictor="secant"),
+                             **kw)
+    assert abs(secant.F[-1] / res.F[-1] - 1) < 5e-3
