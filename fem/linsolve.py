@@ -46,11 +46,6 @@ def superlu_factor(K: sp.spmatrix):
     return spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
 
 
-def superlu_solve(K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
-    """x with K x = b by SuperLU (:func:`superlu_factor`)."""
-    return superlu_factor(K).solve(b)
-
-
 class SymmetricSolver:
     """Repeated solves K x = b for symmetric sparse K (CSR or CSC, both triangles stored).
 

@@ -493,7 +493,8 @@ class CycleLegs:
     ``branch``), ``_solve(run, h)`` (the converged increment or the exception),
     ``_commit(run, h, solved, branch)``, ``_solved_contact(solved)`` → (F, any contact),
     ``_pair_modulus()`` → E*, ``_start_of_loading()`` → (first step, approach of first yield;
-    :func:`start_of_loading`) and ``_residual_surface(u)`` → (r, z) of the contact surface.
+    :func:`start_of_loading`), ``_residual_surface(u)`` → (r, z) of the contact surface and
+    ``_tangent_predictor(u, dh)`` → the predicted displacements or None (:meth:`_predicted`).
     """
 
     def _walk(self, run: _RunState, h_max: float, unload: np.ndarray, targets=None) -> list[dict]:
@@ -529,6 +530,25 @@ class CycleLegs:
             run.work += quadratic_work(hist.h[-2], run.h, h_new, hist.F[-2], run.F, F)
         else:  # first interval of a branch
             run.work += 0.5 * (run.F + F) * (h_new - run.h)
+
+    def _forget_tangent(self) -> None:
+        """No stored tangent (a new run, a new linear solver): the next predictors are secants."""
+        self._tangent = None  # the solver's matrix of its last linear solve (see _tangent_predictor)
+        self._tangent_ready = False  # _tangent belongs to the last converged increment
+
+    def _predicted(self, run: _RunState, dh: float, first) -> np.ndarray:
+        """Displacements predicted for the next increment of ``dh``: ``first()`` for the first
+        increment and the first after a reversal; the solver's ``_tangent_predictor`` when the
+        option asks for it and the last converged increment's factors are at hand; else the
+        secant of the last two increments. ``_commit`` marks the stored tangent as ready."""
+        tangent_ready, self._tangent_ready = self._tangent_ready, False
+        if run.u_prev is None:
+            return first()
+        if tangent_ready and self.options.predictor == "tangent":
+            u_pred = self._tangent_predictor(run.u, dh)
+            if u_pred is not None:
+                return u_pred
+        return run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
 
     def _out_of_time(self, run: _RunState) -> bool:
         if time.perf_counter() - run.t_start > self.options.max_wall_s:
@@ -762,8 +782,7 @@ class IndentationSolver(CycleLegs):
         self._upper = ConstrainedPattern(*self.disc.csr_pattern)
         self._nd = nd
         self.k_penalty = None
-        self._tangent = None  # (K, fixed dofs, their diagonal value, nodal frames) of the last solve
-        self._tangent_ready = False  # _tangent belongs to the last converged increment
+        self._forget_tangent()  # _tangent: (K, fixed dofs, their diagonal value, nodal frames)
         if self.options.penalty is not None:
             x_arc = self.X[:, self.arc]
             pole_edge = float(np.hypot(*(x_arc[:, 2] - x_arc[:, 0])))
@@ -1003,16 +1022,14 @@ class IndentationSolver(CycleLegs):
         dh = h_new - run.h
         if self.options.penalty_scale == "approach" and h_new > run.h_top:
             self._approach_stiffness(run, h_new)
-        tangent_ready, self._tangent_ready = self._tangent_ready, False
-        u_pred = None
-        if run.u_prev is None:  # first increment, or the first after a reversal
+
+        def first():  # at h = 0 a rigid translation by dh/2: its intersection radius √(R dh) is Hertz's a
             u_pred = run.u.copy()
-            if run.h == 0.0:  # rigid translation by dh/2: its intersection radius √(R dh) is Hertz's a
+            if run.h == 0.0:
                 u_pred[1::2] -= 0.5 * dh
-        elif tangent_ready and self.options.predictor == "tangent":
-            u_pred = self._tangent_predictor(run.u, dh)
-        if u_pred is None:  # secant predictor
-            u_pred = run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
+            return u_pred
+
+        u_pred = self._predicted(run, dh, first)
         u_pred[2 * self.hmesh.equator + 1] = -h_new
         u_pred[2 * self.hmesh.axis] = 0.0
         try:
@@ -1181,7 +1198,7 @@ class IndentationSolver(CycleLegs):
         for k in self.timers:
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(opt.linear_solver)
-        self._tangent, self._tangent_ready = None, False
+        self._forget_tangent()
         self.rejected = []
         self.plastic_frozen_increments = 0
         self.backed_up_increments = 0

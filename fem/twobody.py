@@ -537,7 +537,7 @@ class TwoBodySolver(CycleLegs):
         for k in self.timers:
             self.timers[k] = 0.0
         self.linear = SymmetricSolver(self.options.linear_solver)
-        self._tangent, self._tangent_ready = None, False  # penalty contact: K of the last solve
+        self._forget_tangent()  # _tangent: penalty contact's K of the last solve
         self.rejected = []
         self.plastic_frozen_increments = 0
         self.backed_up_increments = 0
@@ -595,14 +595,7 @@ class TwoBodySolver(CycleLegs):
     def _solve(self, run: _RunState, h_new: float):
         """Newton for one increment to ``h_new``: the converged tuple, or the exception."""
         dh = h_new - run.h
-        tangent_ready, self._tangent_ready = self._tangent_ready, False
-        u_pred = None
-        if run.u_prev is None:  # first increment, or the first after a reversal
-            u_pred = self._predictor(dh) if run.h == 0.0 else run.u.copy()
-        elif tangent_ready and self.options.predictor == "tangent":
-            u_pred = self._tangent_predictor(run.u, dh)
-        if u_pred is None:  # secant predictor
-            u_pred = run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
+        u_pred = self._predicted(run, dh, lambda: self._predictor(dh) if run.h == 0.0 else run.u.copy())
         u_pred = self._apply_bc(u_pred, h_new)
         try:
             newton = self._newton if self.k_penalty is None else self._newton_penalty
