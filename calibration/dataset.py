@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.material import Material
-from ..model.single import representative_strain
+from ..model.single import representative_strain, representative_stress
 
 __all__ = [
     "A_MIN_ELEMENTS",
@@ -258,9 +258,10 @@ def build_dataset(runs: Iterable[tuple[str, object]], per_decade: int = PER_DECA
     return dataclasses.replace(build_dataset_from_curves(curves), elastic_sphere=tuple(elastic_sphere))
 
 
-def quantities(ds: Dataset, beta: float, growth: float = 0.0) -> dict[str, np.ndarray]:
+def quantities(ds: Dataset, beta: float, growth: float = 0.0, spread: float = 0.0) -> dict[str, np.ndarray]:
     """σ_rep, Λ and H̄ of every point for the representative strain ε_rep = β x (1 + γ x),
-    x = a/ρ (β: ``beta``, γ: ``growth``; ``model.single.representative_strain``).
+    x = a/ρ (β: ``beta``, γ: ``growth``; ``model.single.representative_strain``) and σ_rep of
+    log-width W = ``spread`` (``model.single.representative_stress``).
 
     Returns
     -------
@@ -271,7 +272,7 @@ def quantities(ds: Dataset, beta: float, growth: float = 0.0) -> dict[str, np.nd
     sig = np.empty_like(eps)
     for i, c in enumerate(ds.curves):
         m = ds.run == i
-        sig[m] = c.material.flow_stress(eps[m])
+        sig[m] = representative_stress(c.material, eps[m], spread)[0]
     Lam = ds.E_prime * ds.x_rho / sig
     with np.errstate(invalid="ignore"):
         H = np.where(np.isfinite(sig), ds.p_m / sig, 0.0)

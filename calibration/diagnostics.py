@@ -95,7 +95,7 @@ def breakdown(ds: Dataset, coeffs: Coefficients, errors: dict[str, np.ndarray]) 
     of H̄ and c², and the share of the total squared error of each.
     """
     eH, ec = np.asarray(errors["H_bar"]), np.asarray(errors["c2"])
-    lam = quantities(ds, coeffs.beta, coeffs.beta_growth)["Lambda"]
+    lam = quantities(ds, coeffs.beta, coeffs.beta_growth, coeffs.strain_spread)["Lambda"]
     l1, l3 = coeffs.Lambda_I, coeffs.Lambda_III
     inner = [v for v in (10.0, 30.0, 100.0, 300.0, 1000.0) if l1 < v < l3]
     g = lambda v: f"{v:.3g}"  # noqa: E731

@@ -27,7 +27,14 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import COUNTER_BOUND, LITERATURE, SCHEMA_VERSION, Coefficients, CollapseLimit
-from ..model.single import BodyLaw, curvature_ratio, effective_exponent, flow_log_slope, representative_strain
+from ..model.single import (
+    BodyLaw,
+    curvature_ratio,
+    effective_exponent,
+    representative_strain,
+    representative_stress,
+    spread_factors,
+)
 from .dataset import Dataset
 
 #: collapse c²_c is parametrised by its value and slopes at this a/R
@@ -66,6 +73,8 @@ class Form:
     eps_hi: float = 0.1
     strain_growth: bool = False  # ε_rep = β x (1 + γ x) with γ fitted (else γ = 0)
     counter: bool = False       # counter-surface terms exp(q s(a/ρ − a/R)) of H̄_hs, c²_hs (ratio a/R)
+    counter_by_level: bool = False  # ... with Level III values q_III, q = (1 − s_l) q + s_l q_III
+    strain_spread: float = 0.0  # W of the representative stress (``single.representative_stress``)
 
     # ------------------------------------------------------------------ parameters
     def parameters(self) -> list[tuple[str, float, float, float]]:
@@ -110,6 +119,9 @@ class Form:
         if self.has_counter:
             p += [("counter_H", 0.0, -COUNTER_BOUND, COUNTER_BOUND),
                   ("counter_c2", 0.0, -COUNTER_BOUND, COUNTER_BOUND)]
+            if self.counter_by_level:
+                p += [("counter_H3", 0.0, -COUNTER_BOUND, COUNTER_BOUND),
+                      ("counter_c23", 0.0, -COUNTER_BOUND, COUNTER_BOUND)]
         return p
 
     @property
@@ -140,6 +152,7 @@ class Form:
             "provenance": {},
             "beta": v["beta"],
             **({"beta_growth": v["beta_growth"]} if self.strain_growth else {}),
+            **({"strain_spread": self.strain_spread} if self.strain_spread else {}),
             "Lambda_I": lam1,
             "Lambda_III": lam1 * math.exp(v["ln_Lambda_III_over_I"]),
             "H_bar_III": {"prefactor": v["H_III"], "exp_poly": seq("H_III_n", self.n_III_H)},
@@ -159,6 +172,8 @@ class Form:
         }
         if self.has_counter:
             d["counter_surface"] = {"H_bar": v["counter_H"], "c2": v["counter_c2"]}
+            if self.counter_by_level:
+                d["counter_surface"].update(H_bar_plastic=v["counter_H3"], c2_plastic=v["counter_c23"])
         if self.collapse:
             # ln c²_c = ln c0 + Σ_k d_k (x − X_C2)^(k+1) + n Σ_k e_k (x − X_C2)^(k+1) + ...,
             # expanded in powers of x for the schema (the n e(0) part joins exp_poly[0])
@@ -225,8 +240,11 @@ def _unchecked(d: dict) -> Coefficients:
         collapse_sharpness_c2=None if col is None else col.get("sharpness_c2"),
         collapse_offset_c2=None if col is None else col.get("offset_c2"),
         level_II_smooth=lev2["smooth"], beta_growth=d.get("beta_growth", 0.0),
+        strain_spread=d.get("strain_spread", 0.0),
         counter_H_bar=d.get("counter_surface", {}).get("H_bar", 0.0),
-        counter_c2=d.get("counter_surface", {}).get("c2", 0.0), source=d["source"],
+        counter_c2=d.get("counter_surface", {}).get("c2", 0.0),
+        counter_H_bar_plastic=d.get("counter_surface", {}).get("H_bar_plastic"),
+        counter_c2_plastic=d.get("counter_surface", {}).get("c2_plastic"), source=d["source"],
         schema_version=d["schema_version"])
 
 
@@ -274,14 +292,14 @@ def point_inputs(ds: Dataset, co: Coefficients):
     """Per-point inputs of the level functions, memoised in ``ds.cache``: the effective
     hardening exponent n, σ_rep, Λ, the elastic mask, the finite-size ratio y (a/R or a/ρ)
     and z = R/ρ − 1 of the rigid partner (ρ: Hertz relative radius)."""
-    key = ("n_eff", co.eps_lo, co.eps_hi)
+    key = ("n_eff", co.eps_lo, co.eps_hi, co.strain_spread)
     n_eff = ds.cache.get(key)
     if n_eff is None:
         n_eff = ds.cache[key] = _per_point(
             ds, [0.0 if math.isinf(c.material.sigma_y) else effective_exponent(c.material, co)
                  for c in ds.curves])
-    sig, Lam, elastic = _memo(ds, "sigma_rep", (co.beta, co.beta_growth),
-                              lambda: _sigma_rep(ds, co.beta, co.beta_growth))
+    sig, Lam, elastic = _memo(ds, "sigma_rep", (co.beta, co.beta_growth, co.strain_spread),
+                              lambda: _sigma_rep(ds, co.beta, co.beta_growth, co.strain_spread))
     y = ds.x_R if co.finite_size_ratio == "a_over_R" else ds.x_rho
     z = ds.cache.get("z")
     if z is None:
@@ -300,15 +318,9 @@ def counter_surface_at(ds: Dataset, co: Coefficients) -> np.ndarray:
 
 
 def flow_log_slope_at(ds: Dataset, co: Coefficients) -> np.ndarray:
-    """m = d ln σ_f/d ln ε_p at every point's ε_rep (0 for elastic bodies), memoised by (β, γ)."""
-    def make():
-        eps = representative_strain(ds.x_rho, co.beta, co.beta_growth)[0]
-        m = np.zeros(ds.size)
-        for i, c in enumerate(ds.curves):
-            sel = ds.run == i
-            m[sel] = flow_log_slope(c.material, eps[sel])
-        return m
-    return _memo(ds, "flow_log_slope", (co.beta, co.beta_growth), make)
+    """m = d ln σ_rep/d ln ε_rep at every point (0 for elastic bodies;
+    ``single.representative_stress``), memoised by (β, γ, W)."""
+    return _representative_stress(ds, co.beta, co.beta_growth, co.strain_spread)[1]
 
 
 def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
@@ -341,8 +353,9 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     gH = 1.0
     if co.has_counter_surface:
         su = counter_surface_at(ds, co)
-        gH = np.exp(co.counter_H_bar * su)
-        H, c = H * gH, c * np.exp(co.counter_c2 * su)
+        (qH, _), (qc, _) = co.counter_by_level(levels.level_weight(Lam, co)[0])
+        gH = np.exp(qH * su)
+        H, c = H * gH, c * np.exp(qc * su)
     if co.has_collapse:
         where = (co.finite_size_ratio, co.eps_lo, co.eps_hi)
         lnHc = _memo(ds, "ln_Hc", (co.collapse_H_bar,) + where,
@@ -359,21 +372,36 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     return p, c
 
 
-def _sigma_rep(ds: Dataset, beta: float, growth: float = 0.0):
-    """σ_rep = σ_f(ε_rep), ε_rep = β x (1 + γ x) with x = a/ρ, Λ = E' x/σ_rep (0 for elastic
-    bodies) and the elastic mask."""
-    mats = [c.material for c in ds.curves]
-    eps = representative_strain(ds.x_rho, beta, growth)[0]
-    if any(m.is_tabulated for m in mats):
-        sig = np.empty(ds.size)
-        for i, m in enumerate(mats):
-            sel = ds.run == i
-            sig[sel] = m.flow_stress(eps[sel])
-    else:
-        sy = _per_point(ds, [m.sigma_y for m in mats])
-        K = _per_point(ds, [m.K for m in mats])
-        n = _per_point(ds, [m.n for m in mats])
-        sig = sy + K * eps**n
+def _representative_stress(ds: Dataset, beta: float, growth: float, spread: float):
+    """σ_rep and m = d ln σ_rep/d ln ε_rep (``single.representative_stress``) at every point's
+    ε_rep = β x (1 + γ x), x = a/ρ, memoised by (β, γ, W): the Ludwik runs all at once, the
+    tabulated ones run by run."""
+    def make():
+        mats = [c.material for c in ds.curves]
+        eps = representative_strain(ds.x_rho, beta, growth)[0]
+        ludwik = [not m.is_tabulated for m in mats]
+        sy = _per_point(ds, [m.sigma_y if lu else 1.0 for m, lu in zip(mats, ludwik, strict=True)])
+        K = _per_point(ds, [m.K if lu else 0.0 for m, lu in zip(mats, ludwik, strict=True)])
+        n = _per_point(ds, [m.n if lu else 1.0 for m, lu in zip(mats, ludwik, strict=True)])
+        sig = np.zeros(ds.size)
+        dsig = np.zeros(ds.size)  # Σ w_j ε_j σ_f'(ε_j)
+        for f, w in spread_factors(spread):
+            t = K * (f * eps) ** n
+            sig, dsig = sig + w * (sy + t), dsig + w * n * t
+        with np.errstate(invalid="ignore"):
+            m = np.where(np.isfinite(sig), dsig / sig, 0.0)  # 0 for elastic bodies (σ_Y = inf)
+        for i, mat in enumerate(mats):
+            if not ludwik[i]:
+                sel = ds.run == i
+                sig[sel], m[sel] = representative_stress(mat, eps[sel], spread)
+        return sig, m
+    return _memo(ds, "sigma_rep_m", (beta, growth, spread), make)
+
+
+def _sigma_rep(ds: Dataset, beta: float, growth: float = 0.0, spread: float = 0.0):
+    """σ_rep (``single.representative_stress``, log-width W = ``spread``) at ε_rep = β x (1 + γ x)
+    with x = a/ρ, Λ = E' x/σ_rep (0 for elastic bodies) and the elastic mask."""
+    sig = _representative_stress(ds, beta, growth, spread)[0]
     elastic = ~np.isfinite(sig)
     Lam = np.where(elastic, 0.0, ds.E_prime * ds.x_rho / np.where(elastic, 1.0, sig))
     return sig, Lam, elastic
@@ -450,6 +478,27 @@ FORMS: dict[str, Form] = {
                                      n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
                                      n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
                                      counter=True),
+    "smooth2_fs2_xn2n_x2_g_csl": Form("smooth2_fs2_xn2n_x2_g_csl", "as smooth2_fs2_xn2n_x2_g_cs, "
+                                      "counter-surface terms with Level III values (blended by the "
+                                      "level weight)", smooth=True, n_shape_H=2, n_shape_c=2,
+                                      n_finite_H=2, n_finite_c=2, finite_by_level=True,
+                                      n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
+                                      n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
+                                      counter=True, counter_by_level=True),
+    "smooth2_fs2_xn2n_x2_g_csl_w1": Form("smooth2_fs2_xn2n_x2_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl, "
+                                         "σ_rep averaged over strains of log-width W = 1 about "
+                                         "ε_rep", smooth=True, n_shape_H=2, n_shape_c=2,
+                                         n_finite_H=2, n_finite_c=2, finite_by_level=True,
+                                         n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
+                                         n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
+                                         counter=True, counter_by_level=True, strain_spread=1.0),
+    "smooth2_fs2_xn2n_x3_g_csl_w1": Form("smooth2_fs2_xn2n_x3_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl_w1, "
+                                         "both collapse limits cubic in a/R", smooth=True,
+                                         n_shape_H=2, n_shape_c=2, n_finite_H=2, n_finite_c=2,
+                                         finite_by_level=True, n_collapse_H=3, n_collapse_c=3,
+                                         n_collapse_nH=2, n_collapse_xnH=2, n_collapse_xnc=2,
+                                         strain_growth=True, counter=True, counter_by_level=True,
+                                         strain_spread=1.0),
     "smooth2_fs2_xn2n_x3_g_cs": Form("smooth2_fs2_xn2n_x3_g_cs", "as smooth2_fs2_xn2n_x2_g_cs, both "
                                      "collapse limits cubic in a/R", smooth=True, n_shape_H=2,
                                      n_shape_c=2, n_finite_H=2, n_finite_c=2, finite_by_level=True,
@@ -467,9 +516,10 @@ FORMS: dict[str, Form] = {
                             c2_offset=True),
 }
 #: forms compared by cross-validation in every calibration: the seed's, the form chosen on
-#: campaign v2 before the collapse limits were made quadratic in a/R, the quadratic collapse
-#: limits, and the same with the counter-surface terms (calibration/README.md). The steps that
-#: led to smooth2_fs2_xn2n_g (smooth2_fs2, _g, _xn_g, _xn2_g) and the forms they beat (the cubic
-#: limits with and without the counter-surface terms among them) stay in FORMS for ``--forms``:
-#: cross-validating every form costs a minute per four forms.
-CANDIDATES = ("seed", "smooth2_fs2_xn2n_g", "smooth2_fs2_xn2n_x2_g", "smooth2_fs2_xn2n_x2_g_cs")
+#: campaign v2 before the representative stress averaged the flow curve (counter-surface terms
+#: the same in every level), and that average with level-dependent counter-surface terms, with
+#: collapse limits quadratic and cubic in a/R (calibration/README.md). The steps that led there
+#: (smooth2_fs2, _g, _xn_g, _xn2_g, _xn2n_g, _x2_g, _csl) and the forms they beat stay in FORMS
+#: for ``--forms``: cross-validating every form costs a minute per four forms.
+CANDIDATES = ("seed", "smooth2_fs2_xn2n_x2_g_cs", "smooth2_fs2_xn2n_x2_g_csl_w1",
+              "smooth2_fs2_xn2n_x3_g_csl_w1")

@@ -105,7 +105,11 @@ class _Parts:
         self.su = counter_surface_at(ds, co)  # s(u) of the counter-surface terms
         H_hs, c_hs = H_q * self.fH, c_q * self.fc
         if co.has_counter_surface:
-            H_hs, c_hs = H_hs * np.exp(co.counter_H_bar * self.su), c_hs * np.exp(co.counter_c2 * self.su)
+            (qH, dqH), (qc, dqc) = co.counter_by_level(s)
+            H_hs, c_hs = H_hs * np.exp(qH * self.su), c_hs * np.exp(qc * self.su)
+            # their level weight moves with Λ like the finite-size factors' (d ln/d ln Λ)
+            self.lfH = self.lfH + dqH * ds_l * self.su
+            self.lfc = self.lfc + dqc * ds_l * self.su
         self.pos = pos = (H_hs > 0.0) & ~elastic
         zero = np.zeros_like(H_hs)
         one = np.ones_like(H_hs)
@@ -248,11 +252,16 @@ def _log_derivatives(parts: _Parts, name: str, co: Coefficients):
         dsig = parts.strain(name)
         gH, gc = parts.sH + parts.lfH, parts.sc + parts.lfc
         return dsig * (1.0 - parts.A * gH), -dsig * (parts.CcH * gH + parts.Ccc * gc)
-    if name == "counter_H":  # ln H̄_hs (and the Hertz p_m of elastic points) move by s(u)
-        g = np.where(parts.pos, parts.su, 0.0)
-        return np.where(parts.elastic, parts.su, parts.A * g), parts.CcH * g
-    if name == "counter_c2":
-        return zero, parts.Ccc * parts.su
+    if name in ("counter_H", "counter_H3"):  # ln H̄_hs (and the Hertz p_m of elastic points)
+        # move by s(u), by the level weight's share when the terms depend on the level
+        lev = parts.s if name == "counter_H3" else (1.0 - parts.s if co.counter_H_bar_plastic is not None
+                                                     else 1.0)
+        g = np.where(parts.pos, lev * parts.su, 0.0)
+        return np.where(parts.elastic, lev * parts.su, parts.A * g), parts.CcH * g
+    if name in ("counter_c2", "counter_c23"):
+        lev = parts.s if name == "counter_c23" else (1.0 - parts.s if co.counter_c2_plastic is not None
+                                                      else 1.0)
+        return zero, parts.Ccc * lev * parts.su
     if base in _HALF_SPACE_H:
         g, elastic = parts.half_space_H(_HALF_SPACE_H[base], k, co)
         return np.where(parts.elastic, elastic, parts.A * g), parts.CcH * g

@@ -39,7 +39,7 @@ from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
 from .interface import InterfaceFit, fit_interface, load_pairs, two_body_runs
 from .threads import single_threaded_blas
-from .unloading import TAIL, UnloadingFit, fit_unloading
+from .unloading import H_RES_WEIGHT, TAIL, UnloadingFit, fit_unloading
 from .workers import DEFAULT_WORKERS, Workers
 
 __all__ = ["Calibration", "calibrate_runs", "calibrate", "load_runs", "coefficient_file",
@@ -339,7 +339,7 @@ def calibrated_range(ds: Dataset, coeffs: Coefficients) -> dict:
     plastic = [m for m in mats if math.isfinite(m.sigma_y)]
     ns = [effective_exponent(m, coeffs) if m.is_tabulated else (m.n if m.K > 0.0 else 0.0)
           for m in plastic]
-    lam = quantities(ds, coeffs.beta, coeffs.beta_growth)["Lambda"]
+    lam = quantities(ds, coeffs.beta, coeffs.beta_growth, coeffs.strain_spread)["Lambda"]
     lam = lam[np.isfinite(lam) & (lam > 0.0)]
     return {
         "E_over_sigma_y": _interval([m.E / m.sigma_y for m in plastic]) if plastic else None,
@@ -416,9 +416,10 @@ def coefficient_file(cal: Calibration) -> dict:
         u = cal.unloading
         d["unloading"] = u.section()
         d["provenance"]["unloading_fit"] = {
-            "method": "least squares of F/F_max along every unloading branch of the calibration runs, "
-                      f"residuals r as r*sqrt(1 + (r/{TAIL:g})^2) (the worst branches weigh more), peak "
-                      "state from the FE (calibration/unloading.py)",
+            "method": "least squares of F/F_max along every unloading branch of the calibration runs "
+                      f"and {H_RES_WEIGHT:g} (h_res - h_res,FE)/h_max per branch, residuals r as "
+                      f"r*sqrt(1 + (r/{TAIL:g})^2) (the worst branches weigh more), peak state from the "
+                      "FE (calibration/unloading.py)",
             **{k: ({q: (_stat(x) if isinstance(x, float) else x) for q, x in v.items()}
                   if isinstance(v, dict) else v)
                for k, v in u.summary().items()}}

@@ -45,7 +45,7 @@ def _plots(cal: Calibration, out: Path) -> list[str]:
 
     ds, best = cal.dataset, cal.best
     co = best.coeffs
-    q = quantities(ds, co.beta, co.beta_growth)
+    q = quantities(ds, co.beta, co.beta_growth, co.strain_spread)
     p_mod, c_mod = predict(ds, co)
     H_mod = p_mod / q["sigma_rep"]
     colours = _style(cal)
@@ -223,7 +223,7 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
     L.append("")
     L.append("| run | scene | points | a/R range | Λ range (fitted β) |")
     L.append("|---|---|---|---|---|")
-    q = quantities(ds, best.coeffs.beta, best.coeffs.beta_growth)
+    q = quantities(ds, best.coeffs.beta, best.coeffs.beta_growth, best.coeffs.strain_spread)
     for i, c in enumerate(ds.curves):
         m = ds.run == i
         L.append(f"| {c.key} | {c.scene} | {int(m.sum())} | {ds.x_R[m].min():.3f}–{ds.x_R[m].max():.3f} "

@@ -39,7 +39,15 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   over the radius of the surface pressing the body (a/R_i against a rigid sphere, 0 against
   a flat and between equal spheres), s(u) = max(u, 0)²/(1 + u²) (C¹, bounded by 1) and
   q = ``counter_surface.H_bar`` or ``.c2`` in [−2, 2]: the indenter's own curvature at
-  a/R_i of order one, which the parabolic contact geometry of the half-space law leaves out;
+  a/R_i of order one, which the parabolic contact geometry of the half-space law leaves out.
+  Optional ``H_bar_plastic``, ``c2_plastic``: the fully plastic (Level III) values q_III, and
+  q = (1 − s_l) q + s_l q_III with the level weight s_l as for the finite-size factors
+  (absent: q_III = q). Against a small rigid sphere c² rises with a/R_i while the body is
+  elastic–plastic and falls once it is fully plastic (pile-up around the indenter);
+* representative stress (optional ``strain_spread`` W ≥ 0, absent: 0): σ_rep is the flow
+  curve averaged over a log-normal distribution of strains about ε_rep,
+  σ_rep = ⅔ σ_f(ε_rep) + ⅙ σ_f(ε_rep e^(−√3W)) + ⅙ σ_f(ε_rep e^(√3W)) (three-point
+  Gauss–Hermite), ``single.representative_stress``; W = 0 is σ_rep = σ_f(ε_rep);
 * unloading (optional ``unloading``; absent: Thornton 1997, Hertz from the peak): the
   elastic unloading branch below the largest approach reached, F = F_max ξ^m
   (``unloading.py`` gives the law; :class:`UnloadingCoefficients` the keys).
@@ -157,7 +165,11 @@ LITERATURE: dict = {
 
 
 #: top-level keys a set may leave out (``to_dict`` writes them only when they are not the default)
-_OPTIONAL_TOP_KEYS = ("beta_growth", "interface", "counter_surface", "unloading")
+#: largest log-width of the strain distribution of the representative stress (a factor e^(√3·2)
+#: ≈ 32 between the outer quadrature strains and ε_rep)
+SPREAD_MAX = 2.0
+
+_OPTIONAL_TOP_KEYS = ("beta_growth", "strain_spread", "interface", "counter_surface", "unloading")
 
 #: bound of the counter-surface coefficients: |q| ≤ 2 keeps d ln F/d ln a and d ln h/d ln a
 #: above 2 − |q|/2 ≥ 1 from these terms (ds/d ln u ≤ ½)
@@ -178,8 +190,8 @@ class UnloadingCoefficients:
     size_a: float = 0.0
     size_h: float = 0.0
     size_nu: float = 0.0
-    #: exponent m of a fully plastic peak against a flat: m_p + m_c2 ln c² + m_depth z̄ (z̄: the
-    #: compliance-weighted 2h_i/R_i)
+    #: exponent m of a plastic peak against a flat: m_p + m_c2 ln c² + m_depth z̄ + m_λ λ (z̄: the
+    #: compliance-weighted 2h_i/R_i; m_λ: ``m_lambda``)
     m_plastic: float = 1.5
     m_c2: float = 0.0
     m_depth: float = 0.0
@@ -189,6 +201,12 @@ class UnloadingCoefficients:
     m_elastic_size: float = 0.0
     #: k of the elastic weight w = min(λ, 1)^k, λ = p_m over Hertz's at the same a
     elastic_weight: float = 1.0
+    #: g_U: a curved counter-surface (U = u/(1 + u)) scales the size terms of g_i by (1 − g_U U)
+    size_counter: float = 0.0
+    #: s_c: the stiffness of a plastic peak grows by (c²)^(s_c (1 − w)) (pile-up stiffer, sink-in softer)
+    stiffness_c2: float = 0.0
+    #: m_λ: the plastic exponent grows by m_λ λ against a flat
+    m_lambda: float = 0.0
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in UNLOADING_RANGES}
@@ -199,7 +217,10 @@ UNLOADING_RANGES = {"stiffness": (0.5, 2.0), "size_a": (0.0, 10.0), "size_h": (0
                     "size_nu": (-3.0, 3.0),
                     "m_plastic": (1.0, 2.0), "m_c2": (-1.0, 1.0), "m_depth": (-2.0, 2.0),
                     "m_counter": (1.0, 2.0),
-                    "m_elastic_size": (-1.0, 3.0), "elastic_weight": (0.1, 20.0)}
+                    "m_elastic_size": (-1.0, 3.0), "elastic_weight": (0.1, 20.0),
+                    "size_counter": (0.0, 1.0), "stiffness_c2": (-0.5, 0.5), "m_lambda": (-1.0, 1.0)}
+#: keys of the ``unloading`` section an older file may leave out (absent: 0, the law without them)
+UNLOADING_OPTIONAL = ("size_counter", "stiffness_c2", "m_lambda")
 
 #: allowed ranges of the ``interface`` section's numbers
 _INTERFACE_RANGES = {"coupling": (0.0, 1000.0), "similarity": (0.01, 10.0), "radius": (0.01, 100.0),
@@ -212,27 +233,33 @@ def _counter(d: dict) -> dict:
         return {}
     sec = _section(d, "counter_surface")
     out = {}
-    for key, fld in (("H_bar", "counter_H_bar"), ("c2", "counter_c2")):
+    pairs = [("H_bar", "counter_H_bar"), ("c2", "counter_c2")]
+    pairs += [(k, f) for k, f in (("H_bar_plastic", "counter_H_bar_plastic"),
+                                  ("c2_plastic", "counter_c2_plastic")) if k in sec]
+    for key, fld in pairs:
         q = _number(sec, key, "counter_surface.")
         if not -COUNTER_BOUND <= q <= COUNTER_BOUND:
             raise ValueError(f"coefficients: 'counter_surface.{key}' must lie in "
                              f"[{-COUNTER_BOUND:g}, {COUNTER_BOUND:g}], got {q!r}")
         out[fld] = q
     fs = d.get("finite_size")
-    if (out["counter_H_bar"] or out["counter_c2"]) and isinstance(fs, dict) \
+    if any(out.values()) and isinstance(fs, dict) \
             and fs.get("ratio") != "a_over_R":
         raise ValueError("coefficients: 'counter_surface' needs 'finite_size.ratio' = 'a_over_R' "
                          f"(u = a/rho - a/R), got {fs.get('ratio')!r}")
     return out
 
 
-def _ranged(d: dict, name: str, ranges: dict) -> dict | None:
-    """The numbers of the optional section ``name``, each within its range (None if absent)."""
+def _ranged(d: dict, name: str, ranges: dict, optional=()) -> dict | None:
+    """The numbers of the optional section ``name``, each within its range (None if absent);
+    keys in ``optional`` may be missing (left out of the result)."""
     if name not in d:
         return None
     sec = _section(d, name)
     out = {}
     for key, (lo, hi) in ranges.items():
+        if key in optional and key not in sec:
+            continue
         v = _number(sec, key, f"{name}.")
         if not lo <= v <= hi:
             raise ValueError(f"coefficients: '{name}.{key}' must lie in [{lo:g}, {hi:g}], got {v!r}")
@@ -242,8 +269,8 @@ def _ranged(d: dict, name: str, ranges: dict) -> dict | None:
 
 def _unloading(d: dict) -> dict:
     """The optional ``unloading`` section as the ``Coefficients.unloading`` field (absent:
-    Thornton's defaults)."""
-    values = _ranged(d, "unloading", UNLOADING_RANGES)
+    Thornton's defaults; keys of ``UNLOADING_OPTIONAL`` absent: 0)."""
+    values = _ranged(d, "unloading", UNLOADING_RANGES, UNLOADING_OPTIONAL)
     if values is None:
         return {}
     unknown = sorted(set(d["unloading"]) - set(UNLOADING_RANGES))
@@ -454,9 +481,15 @@ class Coefficients:
     collapse_offset_c2: float | None = None     # None: 0
     level_II_smooth: bool = False
     beta_growth: float = 0.0  # γ of ε_rep = β x (1 + γ x); 0: the linear ε_rep = β x
+    #: W, log-width of the strains the representative stress averages the flow curve over
+    #: (``single.representative_stress``); 0: σ_rep = σ_f(ε_rep)
+    strain_spread: float = 0.0
     #: counter-surface coefficients q of H̄_hs and c²_hs (module docstring; 0: none)
     counter_H_bar: float = 0.0
     counter_c2: float = 0.0
+    #: their fully plastic (Level III) values, blended by the level weight (None: the same)
+    counter_H_bar_plastic: float | None = None
+    counter_c2_plastic: float | None = None
     #: two-body interface equation (``unified.py``): coupling λ (0: equal mean pressures alone),
     #: similarity width δ of the fully plastic pressures, and the contact radius a_c/R* and
     #: exponent k of the anchor's move from the Hertz partition to equal strains
@@ -495,6 +528,10 @@ class Coefficients:
         growth = _number(d, "beta_growth", "") if "beta_growth" in d else 0.0
         if not 0.0 <= growth <= 100.0:
             raise ValueError(f"coefficients: 'beta_growth' must lie in [0, 100], got {growth!r}")
+        spread = _number(d, "strain_spread", "") if "strain_spread" in d else 0.0
+        if not 0.0 <= spread <= SPREAD_MAX:
+            raise ValueError(f"coefficients: 'strain_spread' must lie in [0, {SPREAD_MAX:g}], "
+                             f"got {spread!r}")
         interface = _interface(d)
         counter = _counter(d)
         unloading = _unloading(d)
@@ -595,7 +632,7 @@ class Coefficients:
             collapse_sharpness_c2=kc,
             collapse_offset_c2=sc,
             level_II_smooth=smooth,
-            beta_growth=growth,
+            beta_growth=growth, strain_spread=spread,
             **interface,
             **counter,
             **unloading,
@@ -613,13 +650,13 @@ class Coefficients:
             "provenance": copy.deepcopy(self.provenance),
             "beta": self.beta,
             **({"beta_growth": self.beta_growth} if self.beta_growth else {}),
+            **({"strain_spread": self.strain_spread} if self.strain_spread else {}),
             **({"interface": {"coupling": self.interface_coupling,
                               "similarity": self.interface_similarity,
                               "radius": self.interface_radius,
                               "exponent": self.interface_exponent}}
                if self.interface_coupling else {}),
-            **({"counter_surface": {"H_bar": self.counter_H_bar, "c2": self.counter_c2}}
-               if self.has_counter_surface else {}),
+            **({"counter_surface": self._counter_section()} if self.has_counter_surface else {}),
             **({"unloading": self.unloading.to_dict()}
                if self.unloading != UnloadingCoefficients() else {}),
             "Lambda_I": self.Lambda_I,
@@ -721,7 +758,26 @@ class Coefficients:
 
     @property
     def has_counter_surface(self) -> bool:
-        return bool(self.counter_H_bar or self.counter_c2)
+        return bool(self.counter_H_bar or self.counter_c2 or self.counter_H_bar_plastic
+                    or self.counter_c2_plastic)
+
+    def counter_by_level(self, s_l):
+        """Counter-surface coefficients (q_H, q_c) at level weight ``s_l``: (1 − s_l) q + s_l q_III
+        (module docstring; q_III defaults to q), and their derivatives in s_l."""
+        out = []
+        for q, q3 in ((self.counter_H_bar, self.counter_H_bar_plastic),
+                      (self.counter_c2, self.counter_c2_plastic)):
+            d = 0.0 if q3 is None else q3 - q
+            out.append((q + d * s_l, d))
+        return out
+
+    def _counter_section(self) -> dict:
+        sec = {"H_bar": self.counter_H_bar, "c2": self.counter_c2}
+        for key, v in (("H_bar_plastic", self.counter_H_bar_plastic),
+                       ("c2_plastic", self.counter_c2_plastic)):
+            if v is not None:
+                sec[key] = v
+        return sec
 
     @property
     def has_collapse(self) -> bool:

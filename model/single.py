@@ -4,6 +4,9 @@ With x = a/ρ (all quantities are functions of a and ρ only through x, except t
 finite-size ratio when it is a/R):
 
     ε_rep = β x (1 + γ x),  σ_rep = σ_f(ε_rep),  Λ = E' x/σ_rep   (seed eqs. 2–4; γ below)
+
+(with a strain spread W > 0, σ_rep averages σ_f over strains about ε_rep:
+:func:`representative_stress`)
     p_m = H̄(Λ) σ_rep  (Level I: p_m = 4E'x/(3π), Hertz)          (seed eq. 1)
     h = a²/(2c²ρ) = a x/(2c²),   F = π a² p_m                   (seed eq. 5)
 
@@ -57,6 +60,8 @@ from .material import Material
 
 __all__ = [
     "representative_strain",
+    "representative_stress",
+    "spread_factors",
     "curvature_ratio",
     "flow_log_slope",
     "effective_exponent",
@@ -95,6 +100,45 @@ def representative_strain(x, beta: float, growth: float = 0.0):
     return beta * x * (1.0 + gx), (1.0 + 2.0 * gx) / (1.0 + gx)
 
 
+#: three-point Gauss–Hermite rule of a standard normal variable t: nodes t_j, weights w_j
+_GH_NODES = (0.0, -math.sqrt(3.0), math.sqrt(3.0))
+_GH_WEIGHTS = (2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0)
+
+
+def spread_factors(spread: float) -> tuple[tuple[float, float], ...]:
+    """(e^(W t_j), w_j) of the representative stress's strain distribution, W = ``spread``
+    (one factor 1 with weight 1 for W = 0)."""
+    if spread == 0.0:
+        return ((1.0, 1.0),)
+    return tuple((math.exp(spread * t), w) for t, w in zip(_GH_NODES, _GH_WEIGHTS, strict=True))
+
+
+def representative_stress(material: Material, eps, spread: float = 0.0):
+    """σ_rep and m = d ln σ_rep/d ln ε_rep at ε_rep (vectorised): the flow curve averaged over a
+    log-normal distribution of strains of log-width W = ``spread`` about ε_rep,
+
+        σ_rep = Σ_j w_j σ_f(ε_rep e^(W t_j))   (three-point Gauss–Hermite: ⅔, ⅙, ⅙ at t = 0, ±√3),
+
+    the strains of the plastic zone spreading from its elastic boundary to several ε_rep under
+    the contact. For a power law σ_f = K εⁿ it is σ_f(ε_rep) times a constant (absorbed by H̄);
+    for a curve with a yield plateau, a saturating or a linear one it weighs the strains
+    around ε_rep. W = 0: σ_f(ε_rep) and :func:`flow_log_slope`, bit for bit."""
+    if spread == 0.0:
+        return material.flow_stress(eps), flow_log_slope(material, eps)
+    e = np.maximum(np.asarray(eps, dtype=float), 0.0)
+    sig = np.zeros_like(e)
+    dsig = np.zeros_like(e)  # Σ w_j ε_j σ_f'(ε_j) = ε dσ_rep/dε
+    elastic = material.is_rigid or math.isinf(material.sigma_y)
+    for f, w in spread_factors(spread):
+        s = material.flow_stress(f * e)
+        sig = sig + w * s
+        if not elastic:
+            dsig = dsig + w * flow_log_slope(material, f * e) * s
+    with np.errstate(invalid="ignore", divide="ignore"):
+        m = np.zeros_like(e) if elastic else np.where(sig > 0.0, dsig / sig, 0.0)
+    return sig, m
+
+
 def curvature_ratio(radius, rho_hertz):
     """z = R/ρ_H − 1 of a body of radius R whose Hertz relative radius is ρ_H (vectorised).
 
@@ -112,11 +156,13 @@ def effective_exponent(material: Material, coeffs: Coefficients) -> float:
 
     ``secant_loglog``: n = ln(σ_f(ε_hi)/σ_f(ε_lo)) / ln(ε_hi/ε_lo) — exact for
     σ_f = K ε^n, 0 for perfect plasticity; one value per material, so Level III
-    stays self-similar (Biwa & Storåkers 1995) and F(h) stays smooth.
+    stays self-similar (Biwa & Storåkers 1995) and F(h) stays smooth. σ_f is the averaged
+    curve the representative stress reads (:func:`representative_stress`).
     """
     if material.is_rigid or math.isinf(material.sigma_y):
         return 0.0
-    s_lo, s_hi = material.flow_stress(np.array([coeffs.eps_lo, coeffs.eps_hi]))
+    s_lo, s_hi = representative_stress(material, np.array([coeffs.eps_lo, coeffs.eps_hi]),
+                                       coeffs.strain_spread)[0]
     return float(math.log(s_hi / s_lo) / math.log(coeffs.eps_hi / coeffs.eps_lo))
 
 
@@ -140,12 +186,17 @@ def hardening_magnitude(material: Material, coeffs: Coefficients) -> float:
     return float(d_hi / coeffs.eps_hi ** min(max(n_l, 0.0), 1.0) / s0)
 
 
-def _segment(material: Material, eps) -> np.ndarray:
-    """Index of the flow-curve piece containing ε (0 for Ludwik curves)."""
+def _segment(material: Material, eps, spread: float = 0.0) -> np.ndarray:
+    """Index of the flow-curve piece containing ε (0 for Ludwik curves); with a strain spread,
+    one index for the pieces of all the strains σ_rep reads (:func:`representative_stress`)."""
     if not material.is_tabulated:
         return np.zeros(np.shape(eps), dtype=np.int64)
     et = np.asarray(material.eps_table)
-    return np.clip(np.searchsorted(et, eps, side="right") - 1, 0, et.size - 2)
+    idx = np.zeros(np.shape(eps), dtype=np.int64)
+    for f, _ in spread_factors(spread):
+        seg = np.clip(np.searchsorted(et, f * np.asarray(eps), side="right") - 1, 0, et.size - 2)
+        idx = idx * (et.size - 1) + seg
+    return idx
 
 
 class BodyResponse(NamedTuple):
@@ -199,15 +250,25 @@ class BodyLaw:
             zero = np.zeros_like(x)
             return zero, zero, np.full_like(x, math.inf), zero
         eps, g = representative_strain(x, co.beta, co.beta_growth)
-        sig = mat.flow_stress(eps)
-        m = flow_log_slope(mat, eps) * g
+        sig, m = representative_stress(mat, eps, co.strain_spread)
+        m = m * g
         s, ds = level_weight(mat.E_prime * x / sig, co)
         return s, ds * (1.0 - m), self.H_bar_III * sig, m
+
+    def _level_at(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """Level weight s at x = a/ρ and ds/d ln x = (ds/d ln Λ)(1 − m) (0 for an elastic body)."""
+        mat, co = self.material, self.coeffs
+        if math.isinf(mat.sigma_y):
+            return np.zeros_like(x), np.zeros_like(x)
+        eps, g = representative_strain(x, co.beta, co.beta_growth)
+        sig, m = representative_stress(mat, eps, co.strain_spread)
+        s, ds = level_weight(mat.E_prime * x / sig, co)
+        return s, ds * (1.0 - m * g)
 
     def _piece(self, Lam, eps, y) -> np.ndarray:
         """Smooth-piece id from the stage of Λ (``levels.stage``: the levels, and the end of the
         unloading onset ramp in Level II), ε_rep (flow-table segment) and y (beyond x_fit_max)."""
-        piece = stage(Lam, self.coeffs) + 4 * _segment(self.material, eps)
+        piece = stage(Lam, self.coeffs) + 4 * _segment(self.material, eps, self.coeffs.strain_spread)
         if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
             piece = 2 * piece + (y > self.x_fit_max)
         return piece
@@ -223,7 +284,7 @@ class BodyLaw:
         if math.isinf(mat.sigma_y):
             Lam = np.zeros_like(x)
         else:
-            Lam = mat.E_prime * x / mat.flow_stress(eps)
+            Lam = mat.E_prime * x / representative_stress(mat, eps, co.strain_spread)[0]
         return self._piece(Lam, eps, y)
 
     def response(self, x, y=None, z: float = 0.0, xc=None) -> BodyResponse:
@@ -235,7 +296,10 @@ class BodyLaw:
         alone, not on the partition: their slopes go to the y slot, so that they leave the
         two-body κ equation monotone in u (``unified.py``; with u = x − y the pressure term's
         negative slope in x made the κ equation lose its single root for some plastic pairs).
-        With the c² term alone on u = x − y the pair grid's monotonicity check fails."""
+        With the c² term alone on u = x − y the pair grid's monotonicity check fails. The level
+        weight that moves the terms' coefficients (``counter_by_level``) is read at xc as well, for
+        the same reason: read at x it left 27 of 300 random plastic pairs without a consistent root
+        from h/R ≈ 0.32 on."""
         mat, co = self.material, self.coeffs
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
@@ -246,9 +310,9 @@ class BodyLaw:
             Lam = np.zeros_like(x)
             m = np.zeros_like(x)
         else:
-            sig = mat.flow_stress(eps)
+            sig, m = representative_stress(mat, eps, co.strain_spread)
             Lam = Ep * x / sig
-            m = flow_log_slope(mat, eps) * g  # d ln σ_rep/d ln x
+            m = m * g  # d ln σ_rep/d ln x
         H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III)
         with np.errstate(invalid="ignore"):
             p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
@@ -261,15 +325,18 @@ class BodyLaw:
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
         if co.has_counter_surface:  # exp(q s(u)), u = x − y (``levels.counter_surface``)
-            qH, qc = co.counter_H_bar, co.counter_c2
             if xc is None:
                 su, su_x, su_y = counter_surface(x, y)
-            else:  # u = xc − y moves with a only: every slope in the y slot
+                s_c, lev_x, lev_y = s_l, ds_l * (1.0 - m), 0.0  # level weight, d/d ln x, d/d ln y
+            else:  # u = xc − y moves with a only: every slope in the y slot, the level weight too
                 su, su_x, su_y = counter_surface(np.asarray(xc, dtype=float), y)
                 su_x, su_y = 0.0, su_x + su_y
+                s_c, ds_c = self._level_at(np.asarray(xc, dtype=float))
+                lev_x, lev_y = 0.0, ds_c
+            (qH, dqH), (qc, dqc) = co.counter_by_level(s_c)  # q(s), dq/ds
             p, c = p * np.exp(qH * su), c * np.exp(qc * su)
-            dp_x, dp_y = dp_x + qH * su_x, dp_y + qH * su_y
-            dc_x, dc_y = dc_x + qc * su_x, dc_y + qc * su_y
+            dp_x, dp_y = dp_x + qH * su_x + dqH * su * lev_x, dp_y + qH * su_y + dqH * su * lev_y
+            dc_x, dc_y = dc_x + qc * su_x + dqc * su * lev_x, dc_y + qc * su_y + dqc * su * lev_y
         if co.has_collapse and not math.isinf(mat.sigma_y):
             b = collapse_blend(p / sig, c, y, co, self.n_eff, z)
             w, wc = b.w, b.w_c2

@@ -29,11 +29,12 @@ KEYS = {"E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "
 OLD_KEYS = KEYS - {"K_over_sigma_y", "R_over_R_rigid"}
 
 
-def _expected(ds, beta, growth: float = 0.0) -> dict:
+def _expected(ds, beta, growth: float = 0.0, spread: float = 0.0) -> dict:
     """The range straight from the records: materials of the runs, extremes over the points
-    (Λ with the representative strain ε_rep = β x (1 + γ x), γ = ``growth``)."""
+    (Λ with the representative strain ε_rep = β x (1 + γ x), γ = ``growth``, and the
+    representative stress of log-width ``spread``)."""
     mats = [c.material for c in ds.curves]
-    lam = quantities(ds, beta, growth)["Lambda"]
+    lam = quantities(ds, beta, growth, spread)["Lambda"]
     return {"E_over_sigma_y": [min(m.E / m.sigma_y for m in mats), max(m.E / m.sigma_y for m in mats)],
             "nu": [min(m.nu for m in mats), max(m.nu for m in mats)],
             "hardening_n": [min(m.n if m.K > 0 else 0.0 for m in mats),
@@ -71,7 +72,8 @@ def test_calibrated_range_is_written_and_matches_the_runs():
     d = json.loads(json.dumps(coefficient_file(cal)))
     block = d["provenance"]["calibrated_range"]
     ds = cal.dataset
-    want = _expected(ds, cal.best.coeffs.beta, cal.best.coeffs.beta_growth)
+    co = cal.best.coeffs
+    want = _expected(ds, co.beta, co.beta_growth, co.strain_spread)
     _assert_matches(block, want)
     # the cases of the synthetic grid: E/σY 10…10000, ν 0.3, Ludwik n 0 (perfectly plastic) … 0.5
     assert block["E_over_sigma_y"] == [10.0, 10000.0]
@@ -107,5 +109,6 @@ def test_shipped_file_records_the_range_of_its_calibration_runs():
     if source["calibration_runs_hash"] != d["provenance"]["fe_dataset"]["calibration_runs_hash"]:
         pytest.skip("data/coefficients.json was calibrated on other calibration runs")
     ds = build_dataset(runs)
-    _assert_matches(d["provenance"]["calibrated_range"], _expected(ds, d["beta"], d.get("beta_growth", 0.0)),
+    _assert_matches(d["provenance"]["calibrated_range"], _expected(ds, d["beta"], d.get("beta_growth", 0.0),
+                                                                     d.get("strain_spread", 0.0)),
                     older_file_ok=True)

@@ -3,6 +3,7 @@ history, cycle() and the coefficient section."""
 
 import math
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -17,7 +18,7 @@ from spherecontact.model import (
     load_coefficients,
     residual_approach,
 )
-from spherecontact.model.coefficients import UnloadingCoefficients
+from spherecontact.model.coefficients import UNLOADING_OPTIONAL, UnloadingCoefficients
 from spherecontact.model.unified import pair
 from spherecontact.model.unloading import EXPONENT_RANGE, branch, features, peak_parameters, unloading_law
 
@@ -54,6 +55,50 @@ def test_default_law_is_thornton():
     np.testing.assert_allclose(m, 1.5)
     np.testing.assert_allclose(delta_e, np.minimum(3 * F / (4 * Ep * a), h))
     np.testing.assert_allclose(h1_res, h_res)
+
+
+def _peaks():
+    """A plastic peak with pile-up (c² = 1.5, λ ≈ 0.06) against a flat and the same against a
+    rigid sphere of radius 1/2 (u = 0.6)."""
+    Ep = 200.0 / (1 - 0.09)
+    F, a, h = np.full(2, 0.5), np.full(2, 0.3), np.full(2, 0.03)
+    return features(h, F, a, np.stack([h, 0 * h], axis=1), [1 / Ep, 0.0], [0.3, 0.3], [1.0, math.inf],
+                    [0.0, 2.0], 1.0, [1.0, 1.0])
+
+
+BASE = UnloadingCoefficients(stiffness=1.1, size_a=0.5, size_h=1.0, m_plastic=1.25, m_c2=0.1,
+                             m_counter=1.2, elastic_weight=2.0)
+
+
+def test_counter_surface_softens_the_size_terms():
+    """g_i = 1 + size_i (1 − g_U U): no change on a flat (U = 0), δ_e ∝ 1/g against a sphere."""
+    f = _peaks()
+    m0, d0, *_ = unloading_law(f, BASE)
+    m1, d1, *_ = unloading_law(f, replace(BASE, size_counter=0.8))
+    size = 0.5 * 0.3**2 + 1.0 * 0.06
+    np.testing.assert_allclose(m1, m0)
+    np.testing.assert_allclose(d1[0], d0[0], rtol=1e-14)
+    np.testing.assert_allclose(d1[1] / d0[1], (1 + size) / (1 + size * (1 - 0.8 * f.U[1])), rtol=1e-12)
+
+
+def test_pile_up_stiffens_a_plastic_peak():
+    """C ∝ (c²)^(−s_c (1 − w)): with c² > 1 and s_c > 0 the recovery δ_e shrinks by that factor."""
+    f = _peaks()
+    assert np.all(f.log_c2 > 0.0) and np.all(f.lam < 0.1)
+    w = f.lam ** BASE.elastic_weight
+    _, d0, *_ = unloading_law(f, BASE)
+    _, d1, *_ = unloading_law(f, replace(BASE, stiffness_c2=0.2))
+    np.testing.assert_allclose(d1 / d0, np.exp(-0.2 * (1 - w) * f.log_c2), rtol=1e-12)
+    assert np.all(d1 < d0)
+
+
+def test_plastic_exponent_grows_with_lambda():
+    """m = (1 − w)[(1 − U)(… + m_λ λ) + U m_counter] + w (…): the term is m_λ λ (1 − w)(1 − U)."""
+    f = _peaks()
+    w = f.lam ** BASE.elastic_weight
+    m0, *_ = unloading_law(f, BASE)
+    m1, *_ = unloading_law(f, replace(BASE, m_lambda=0.5))
+    np.testing.assert_allclose(m1 - m0, 0.5 * f.lam * (1 - w) * (1 - f.U), rtol=1e-12)
 
 
 def test_branch_is_continuous_at_the_peak_and_vanishes_at_h_res(co):
@@ -216,6 +261,30 @@ def test_unloading_section_round_trip_and_errors(co):
     missing = dict(d, unloading={k: v for k, v in d["unloading"].items() if k != "m_c2"})
     with pytest.raises(ValueError, match=r"unloading\.m_c2"):
         Coefficients.from_dict(missing)
+    bad = dict(d, unloading=dict(d["unloading"], size_counter=1.5))
+    with pytest.raises(ValueError, match=r"unloading\.size_counter.*\[0, 1\]"):
+        Coefficients.from_dict(bad)
+
+
+def test_an_older_unloading_section_gives_the_law_without_the_new_terms(co):
+    """Files written before size_counter, stiffness_c2 and m_lambda leave them out: 0."""
+    d = co.to_dict()
+    new = dict(d["unloading"], size_counter=0.5, stiffness_c2=0.1, m_lambda=0.2)
+    older = {k: v for k, v in new.items() if k not in UNLOADING_OPTIONAL}
+    law_old = Coefficients.from_dict(dict(d, unloading=older)).unloading
+    assert law_old == replace(Coefficients.from_dict(dict(d, unloading=new)).unloading,
+                              size_counter=0.0, stiffness_c2=0.0, m_lambda=0.0)
+    # the law before these terms: g_i = 1 + [g_a y² + g_h z][1 + g_ν (ν − 0.3)], m without m_λ λ
+    f, u = _peaks(), law_old
+    Ci = f.compliance / (2 * f.a[:, None] * (1 + (u.size_a * f.y**2 + u.size_h * f.z)
+                                             * (1 + u.size_nu * (f.nu - 0.3))))
+    w = f.lam ** u.elastic_weight
+    m_p = (1 - f.U) * (u.m_plastic + u.m_c2 * f.log_c2 + u.m_depth * f.z[:, 0]) + f.U * u.m_counter
+    m = np.clip((1 - w) * m_p + w * (1.5 + u.m_elastic_size * f.y[:, 0] ** 2), *EXPONENT_RANGE)
+    m_new, delta_e, *_ = unloading_law(f, law_old)
+    np.testing.assert_allclose(m_new, m, rtol=1e-14)
+    np.testing.assert_allclose(delta_e, np.minimum(m * f.F * Ci.sum(axis=1) / u.stiffness, f.h), rtol=1e-14)
+    assert set(law_old.to_dict()) == set(new)  # written back with every key
 
 
 def test_cli_curve_with_unloading(co):

@@ -1,0 +1,142 @@
+"""The representative stress averaged over a spread of strains, and counter-surface terms that
+move with the level (model/single.py, model/coefficients.py, calibration/forms.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from test_calibration import KNOWN_CO, as_run
+
+from spherecontact.calibration import fit as fitmod
+from spherecontact.calibration.dataset import build_dataset
+from spherecontact.calibration.forms import CANDIDATES, FORMS, predict, predict_exact
+from spherecontact.calibration.jacobian import residual_jacobian
+from spherecontact.calibration.synthetic import model_result
+from spherecontact.model import Material, Sphere, contact, default_coefficients
+from spherecontact.model.coefficients import SPREAD_MAX, Coefficients
+from spherecontact.model.single import (
+    BodyLaw,
+    flow_log_slope,
+    representative_stress,
+    spread_factors,
+)
+
+LUDWIK = Material(E=500.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)
+VOCE = Material.from_table(800.0, 0.3, np.linspace(0.0, 1.0, 41),
+                           1.0 + 2.0 * (1.0 - np.exp(-5.0 * np.linspace(0.0, 1.0, 41))))
+EPS = np.geomspace(1e-4, 0.5, 40)
+
+
+def test_no_spread_is_the_flow_curve_bit_for_bit():
+    for mat in (LUDWIK, VOCE, Material(E=300.0, nu=0.3, sigma_y=1.0)):
+        sig, m = representative_stress(mat, EPS, 0.0)
+        assert np.array_equal(sig, mat.flow_stress(EPS))
+        assert np.array_equal(m, flow_log_slope(mat, EPS))
+
+
+def test_three_point_rule_and_power_law_scaling():
+    f = spread_factors(1.0)
+    assert [w for _, w in f] == pytest.approx([2 / 3, 1 / 6, 1 / 6])
+    assert sum(w * math.log(x) ** 2 for x, w in f) == pytest.approx(1.0)  # unit log-variance
+    # a pure power law K εⁿ keeps its exponent: σ_rep = σ_f(ε_rep) Σ w e^(n W t)
+    pure = Material.from_table(100.0, 0.3, np.r_[0.0, np.geomspace(1e-8, 10.0, 4000)],
+                               np.r_[1e-6, 2.0 * np.geomspace(1e-8, 10.0, 4000) ** 0.25])
+    e = np.geomspace(1e-3, 0.5, 12)
+    sig, m = representative_stress(pure, e, 1.0)
+    ratio = sig / pure.flow_stress(e)
+    np.testing.assert_allclose(ratio, sum(w * x**0.25 for x, w in f), rtol=2e-3)
+    np.testing.assert_allclose(m, 0.25, atol=2e-3)
+
+
+def test_log_slope_is_the_derivative_of_the_average():
+    eps = EPS * 1.0137  # off the table's breakpoints (a one-sided slope there)
+    for mat in (LUDWIK, VOCE):
+        sig, m = representative_stress(mat, eps, 1.0)
+        d = 1e-6
+        up = representative_stress(mat, eps * math.exp(d), 1.0)[0]
+        dn = representative_stress(mat, eps * math.exp(-d), 1.0)[0]
+        np.testing.assert_allclose(m, (np.log(up) - np.log(dn)) / (2 * d), atol=2e-4)
+
+
+def test_spread_weighs_a_saturating_curve_below_its_point_value():
+    """Past saturation the average reads the lower strains too; on a linear curve the higher."""
+    sig, _ = representative_stress(VOCE, np.array([0.3]), 1.0)
+    assert sig[0] < VOCE.flow_stress(0.3)
+    lin = Material(E=500.0, nu=0.3, sigma_y=1.0, K=5.0, n=1.0)
+    sig, _ = representative_stress(lin, np.array([0.05]), 1.0)
+    assert sig[0] > lin.flow_stress(0.05)
+
+
+def test_schema_key_range_and_round_trip():
+    co = default_coefficients()
+    d = co.to_dict()
+    d["strain_spread"] = SPREAD_MAX * 1.01
+    with pytest.raises(ValueError, match="strain_spread"):
+        Coefficients.from_dict(d)
+    d["strain_spread"] = 0.7
+    assert Coefficients.from_dict(d).strain_spread == 0.7
+    d.pop("strain_spread")
+    assert Coefficients.from_dict(d).strain_spread == 0.0
+    assert "strain_spread" not in Coefficients.from_dict(d).to_dict()  # older files unchanged
+
+
+def _with(co: Coefficients, **counter) -> Coefficients:
+    return co.replace(counter_surface=counter)
+
+
+def test_counter_terms_by_level_reduce_to_one_value_without_the_plastic_keys():
+    co = default_coefficients()
+    one = _with(co, H_bar=0.3, c2=-0.2)
+    same = _with(co, H_bar=0.3, c2=-0.2, H_bar_plastic=0.3, c2_plastic=-0.2)
+    law1, law2 = BodyLaw(LUDWIK, one), BodyLaw(LUDWIK, same)
+    x = np.geomspace(0.01, 1.2, 50)
+    r1, r2 = law1.response(x, 0.3 * x, 2.0), law2.response(x, 0.3 * x, 2.0)
+    np.testing.assert_allclose(r1.p_m, r2.p_m, rtol=1e-14)
+    np.testing.assert_allclose(r1.dlnp_dlnx, r2.dlnp_dlnx, rtol=1e-12, atol=1e-14)
+    assert one.counter_H_bar_plastic is None and "H_bar_plastic" not in one.to_dict()["counter_surface"]
+    # the Level III value acts where the body is fully plastic and not in Level I
+    diff = _with(co, H_bar=0.3, c2=-0.2, H_bar_plastic=-1.0, c2_plastic=0.5)
+    r3 = BodyLaw(LUDWIK, diff).response(x, 0.3 * x, 2.0)
+    lev1 = r3.Lambda <= co.Lambda_I
+    np.testing.assert_allclose(r3.p_m[lev1], r1.p_m[lev1], rtol=1e-14)
+    assert np.all(r3.p_m[~lev1 & (x > 0.4)] < r1.p_m[~lev1 & (x > 0.4)])
+
+
+@pytest.mark.parametrize("Ri", [0.3, 1.0])
+def test_stiffness_is_dF_dh_with_spread_and_counter_terms_by_level(Ri):
+    co = _with(default_coefficients(), H_bar=0.4, c2=-0.1, H_bar_plastic=-1.0, c2_plastic=0.2)
+    d = co.to_dict()
+    d["strain_spread"] = 1.0
+    co = Coefficients.from_dict(d)
+    s1, s2 = Sphere(1.0, LUDWIK), Sphere(Ri, Material.rigid())
+    h = np.geomspace(1e-4, 0.2 * Ri, 30)
+    st = contact(s1, s2, h, co)
+    e = 1e-6
+    fd = (contact(s1, s2, h * (1 + e), co).F - contact(s1, s2, h * (1 - e), co).F) / (2 * e * h)
+    np.testing.assert_allclose(st.stiffness, fd, rtol=2e-5)
+
+
+def test_calibration_form_with_spread_and_counter_levels_has_exact_jacobian_columns():
+    form = FORMS["smooth2_fs2_xn2n_x2_g_csl_w1"]
+    assert form.name in CANDIDATES
+    assert form.names[-4:] == ["counter_H", "counter_c2", "counter_H3", "counter_c23"]
+    runs = [(f"sphere-{Ri}", as_run(model_result(mat, KNOWN_CO, indenter_radius=Ri, n=60)))
+            for Ri in (math.inf, 0.5, 0.25) for mat in (LUDWIK, VOCE)]
+    ds = build_dataset(runs)
+    x = form.start()
+    x[-4:] = (-0.6, 0.5, 0.8, -0.4)
+    co = form.coefficients(x)
+    assert co.strain_spread == 1.0 and co.counter_H_bar_plastic == pytest.approx(0.8)
+    p1, c1 = predict(ds, co)
+    p2, c2 = predict_exact(ds, co)
+    np.testing.assert_allclose(p1, p2, rtol=1e-12)
+    np.testing.assert_allclose(c1, c2, rtol=1e-12)
+    res = fitmod.Residuals(form, ds)
+    J = residual_jacobian(res, x)
+    for j, name in enumerate(form.names):
+        xj = x.copy()
+        step = 1e-7 * max(1.0, abs(x[j]))
+        xj[j] += step
+        np.testing.assert_allclose(J[:, j], (res(xj) - res(x)) / step, atol=2e-5, err_msg=name)
