@@ -126,9 +126,16 @@ def representative_stress(material: Material, eps, spread: float = 0.0):
     if spread == 0.0:
         return material.flow_stress(eps), flow_log_slope(material, eps)
     e = np.maximum(np.asarray(eps, dtype=float), 0.0)
+    elastic = material.is_rigid or math.isinf(material.sigma_y)
+    if not (elastic or material.is_tabulated):  # Ludwik σ_Y + K εⁿ: ε σ_f' = n K εⁿ
+        sy, K, n = material.sigma_y, material.K, material.n
+        sig = dsig = 0.0
+        for f, w in spread_factors(spread):
+            t = K * (f * e) ** n
+            sig, dsig = sig + w * (sy + t), dsig + w * n * t
+        return sig, dsig / sig
     sig = np.zeros_like(e)
     dsig = np.zeros_like(e)  # Σ w_j ε_j σ_f'(ε_j) = ε dσ_rep/dε
-    elastic = material.is_rigid or math.isinf(material.sigma_y)
     for f, w in spread_factors(spread):
         s = material.flow_stress(f * e)
         sig = sig + w * s
