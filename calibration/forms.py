@@ -19,6 +19,7 @@ Free parameters of a form (bounds in :func:`Form.parameters`):
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -478,27 +479,6 @@ FORMS: dict[str, Form] = {
                                      n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
                                      n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
                                      counter=True),
-    "smooth2_fs2_xn2n_x2_g_csl": Form("smooth2_fs2_xn2n_x2_g_csl", "as smooth2_fs2_xn2n_x2_g_cs, "
-                                      "counter-surface terms with Level III values (blended by the "
-                                      "level weight)", smooth=True, n_shape_H=2, n_shape_c=2,
-                                      n_finite_H=2, n_finite_c=2, finite_by_level=True,
-                                      n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
-                                      n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
-                                      counter=True, counter_by_level=True),
-    "smooth2_fs2_xn2n_x2_g_csl_w1": Form("smooth2_fs2_xn2n_x2_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl, "
-                                         "σ_rep averaged over strains of log-width W = 1 about "
-                                         "ε_rep", smooth=True, n_shape_H=2, n_shape_c=2,
-                                         n_finite_H=2, n_finite_c=2, finite_by_level=True,
-                                         n_collapse_H=2, n_collapse_c=2, n_collapse_nH=2,
-                                         n_collapse_xnH=2, n_collapse_xnc=2, strain_growth=True,
-                                         counter=True, counter_by_level=True, strain_spread=1.0),
-    "smooth2_fs2_xn2n_x3_g_csl_w1": Form("smooth2_fs2_xn2n_x3_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl_w1, "
-                                         "both collapse limits cubic in a/R", smooth=True,
-                                         n_shape_H=2, n_shape_c=2, n_finite_H=2, n_finite_c=2,
-                                         finite_by_level=True, n_collapse_H=3, n_collapse_c=3,
-                                         n_collapse_nH=2, n_collapse_xnH=2, n_collapse_xnc=2,
-                                         strain_growth=True, counter=True, counter_by_level=True,
-                                         strain_spread=1.0),
     "smooth2_fs2_xn2n_x3_g_cs": Form("smooth2_fs2_xn2n_x3_g_cs", "as smooth2_fs2_xn2n_x2_g_cs, both "
                                      "collapse limits cubic in a/R", smooth=True, n_shape_H=2,
                                      n_shape_c=2, n_finite_H=2, n_finite_c=2, finite_by_level=True,
@@ -515,6 +495,23 @@ FORMS: dict[str, Form] = {
                             n_finite_c=2, finite_by_level=True, n_collapse_xnH=1, n_collapse_xnc=1,
                             c2_offset=True),
 }
+
+
+def _derived(base: str, name: str, description: str, **changes) -> Form:
+    """A form of :data:`FORMS` with some fields changed (the forms after ``…_cs`` are steps on it)."""
+    return dataclasses.replace(FORMS[base], name=name, description=description, **changes)
+
+
+FORMS["smooth2_fs2_xn2n_x2_g_csl"] = _derived(
+    "smooth2_fs2_xn2n_x2_g_cs", "smooth2_fs2_xn2n_x2_g_csl", "as smooth2_fs2_xn2n_x2_g_cs, counter-surface "
+    "terms with Level III values (blended by the level weight)", counter_by_level=True)
+FORMS["smooth2_fs2_xn2n_x2_g_csl_w1"] = _derived(
+    "smooth2_fs2_xn2n_x2_g_csl", "smooth2_fs2_xn2n_x2_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl, σ_rep "
+    "averaged over strains of log-width W = 1 about ε_rep", strain_spread=1.0)
+FORMS["smooth2_fs2_xn2n_x3_g_csl_w1"] = _derived(
+    "smooth2_fs2_xn2n_x2_g_csl_w1", "smooth2_fs2_xn2n_x3_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl_w1, both "
+    "collapse limits cubic in a/R", n_collapse_H=3, n_collapse_c=3)
+
 #: forms compared by cross-validation in every calibration: the seed's, the form chosen on
 #: campaign v2 before the representative stress averaged the flow curve (counter-surface terms
 #: the same in every level), and that average with level-dependent counter-surface terms

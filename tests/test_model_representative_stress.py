@@ -8,11 +8,10 @@ import math
 import numpy as np
 import pytest
 from test_calibration import KNOWN_CO, as_run
+from test_model_counter_surface import check_predict_and_jacobian
 
-from spherecontact.calibration import fit as fitmod
 from spherecontact.calibration.dataset import build_dataset
-from spherecontact.calibration.forms import CANDIDATES, FORMS, predict, predict_exact
-from spherecontact.calibration.jacobian import residual_jacobian
+from spherecontact.calibration.forms import CANDIDATES, FORMS
 from spherecontact.calibration.synthetic import model_result
 from spherecontact.model import Material, Sphere, contact, default_coefficients
 from spherecontact.model.coefficients import SPREAD_MAX, Coefficients
@@ -129,14 +128,4 @@ def test_calibration_form_with_spread_and_counter_levels_has_exact_jacobian_colu
     x[-4:] = (-0.6, 0.5, 0.8, -0.4)
     co = form.coefficients(x)
     assert co.strain_spread == 1.0 and co.counter_H_bar_plastic == pytest.approx(0.8)
-    p1, c1 = predict(ds, co)
-    p2, c2 = predict_exact(ds, co)
-    np.testing.assert_allclose(p1, p2, rtol=1e-12)
-    np.testing.assert_allclose(c1, c2, rtol=1e-12)
-    res = fitmod.Residuals(form, ds)
-    J = residual_jacobian(res, x)
-    for j, name in enumerate(form.names):
-        xj = x.copy()
-        step = 1e-7 * max(1.0, abs(x[j]))
-        xj[j] += step
-        np.testing.assert_allclose(J[:, j], (res(xj) - res(x)) / step, atol=2e-5, err_msg=name)
+    check_predict_and_jacobian(form, ds, x)
