@@ -122,3 +122,28 @@ def test_two_body_penalty_pair_starts_each_increment_from_the_last_tangent(monke
     secant = run_indentation(PLASTIC, 1.0, 0.006, options=SolverOptions(penalty=100.0, predictor="secant"),
                              **kw)
     assert abs(secant.F[-1] / res.F[-1] - 1) < 5e-3
+
+
+def test_two_body_penalty_tangent_keeps_one_pattern_per_zone():
+    """The two-body penalty tangent on its fixed superset pattern: one symbolic analysis per
+    contact zone (about a dozen per run, against one per new contact pair on the growing pattern),
+    numeric updates otherwise, and the growing pattern's answers to round-off."""
+    from spherecontact.fem.twobody import TwoBodySolver
+
+    runs = {}
+    for fixed in (True, False):
+        solver = TwoBodySolver(PLASTIC, 1.0, Material(E=600.0, nu=0.3, sigma_y=1.0), 1.0, density=0.5,
+                               options=SolverOptions(penalty=100.0))
+        solver.fixed_pattern = fixed
+        runs[fixed] = (solver, solver.run(0.004))
+    solver, res = runs[True]
+    t, t_old = res.timings, runs[False][1].timings
+    assert res.status == "converged" and t["linear_fallback"] == 0
+    assert 1 <= solver.pattern_builds <= 12
+    assert t["linear_ldl_fresh"] == solver.pattern_builds
+    assert t["linear_ldl_update"] >= 10 * t["linear_ldl_fresh"]
+    assert t_old["linear_ldl_fresh"] >= 2 * t["linear_ldl_fresh"]
+    assert t["newton_iterations"] == t_old["newton_iterations"]
+    for key in ("F", "a", "h1", "h2"):
+        old = runs[False][1].curves[key]
+        np.testing.assert_allclose(res.curves[key], old, rtol=0, atol=1e-9 * np.abs(old).max())
