@@ -206,7 +206,7 @@ def _penalty_keys(co: Coefficients) -> tuple:
     """What each penalty depends on: monotonicity (H̄ half-space law), collapse, finite size."""
     fs = (co.finite_size_H_bar, co.finite_size_c2, co.fs_H_bar_plastic, co.fs_c2_plastic)
     return ((co.Lambda_I, co.Lambda_III, co.H_bar_III_prefactor, co.H_bar_III_exp_poly,
-             co.H_bar_shape, co.level_II_smooth, fs[0], fs[2]),
+             co.H_bar_shape, co.H_bar_shape_n, co.level_II_smooth, fs[0], fs[2]),
             (co.collapse_H_bar, co.collapse_c2), fs, (fs[0], fs[1]))
 
 

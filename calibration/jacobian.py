@@ -44,13 +44,16 @@ _REL_STEP = math.sqrt(np.finfo(float).eps)
 
 
 #: indexed parameter families (name = family + index k)
-_FAMILIES = ("H_III_n", "c2_III_n", "H_shape", "c2_shape", "fs_H", "fs_c2", "fsp_H", "fsp_c2",
+_FAMILIES = ("H_III_n", "c2_III_n", "H_shape", "c2_shape", "H_shape_n", "c2_shape_n", "fs_H", "fs_c2",
+             "fsp_H", "fsp_c2",
              "Hc_x", "Hc_n", "Hc_z", "Hc_xn", "c2c_x", "c2c_n", "c2c_z", "c2c_xn")
 
 
 #: the half-space parameter families of H̄ and c² and what they are (``_Parts._level_values``)
-_HALF_SPACE_H = {"H_III": "III", "H_III_n": "III_n", "H_shape": "shape", "fs_H": "fs", "fsp_H": "fsp"}
-_HALF_SPACE_C = {"c2_III": "III", "c2_III_n": "III_n", "c2_shape": "shape", "fs_c2": "fs", "fsp_c2": "fsp"}
+_HALF_SPACE_H = {"H_III": "III", "H_III_n": "III_n", "H_shape": "shape", "H_shape_n": "shape_n",
+                 "fs_H": "fs", "fsp_H": "fsp"}
+_HALF_SPACE_C = {"c2_III": "III", "c2_III_n": "III_n", "c2_shape": "shape", "c2_shape_n": "shape_n",
+                 "fs_c2": "fs", "fsp_c2": "fsp"}
 
 
 def _split(name: str) -> tuple[str, int]:
@@ -100,8 +103,8 @@ class _Parts:
         self.H_q, self.c_q = H_q, c_q
         self.H_I = co.H_bar_I
         self.smooth = co.level_II_smooth
-        self.shape_H = self._shape_sum(co.H_bar_shape)
-        self.shape_c = self._shape_sum(co.c2_shape)
+        self.shape_H = self._shape_sum(co.H_bar_shape, co.H_bar_shape_n)
+        self.shape_c = self._shape_sum(co.c2_shape, co.c2_shape_n)
         self.su = counter_surface_at(ds, co)  # s(u) of the counter-surface terms
         H_hs, c_hs = H_q * self.fH, c_q * self.fc
         if co.has_counter_surface:
@@ -138,12 +141,14 @@ class _Parts:
         self.dc_dlnk = self.dc_dlnkc if k_c is None else zero
         self.dc_ds = gap * kc * dwc
 
-    def _shape_sum(self, b):
+    def _shape_sum(self, b, bn=()):
         """S(t) of the Level II shape (``levels._shape`` without the slope term m₀) and the
-        factor t²(1 − t)² (smooth) or t(1 − t) (polynomial) that multiplies Σ b_k t^k."""
+        factor t²(1 − t)² (smooth) or t(1 − t) (polynomial) that multiplies Σ (b_k + bn_k n) t^k."""
         t = self.t
         u = 1.0 - t
         P = levels._poly_and_derivative(t, b)[0] if b else np.zeros_like(t)
+        if bn:
+            P = P + self.n * levels._poly_and_derivative(t, bn)[0]
         if self.smooth:
             base = t * t * u * u
             return t * t * (3.0 - 2.0 * t) + base * P, base
@@ -166,6 +171,8 @@ class _Parts:
                 return d_III * q_III * self.n ** (k + 1) / q_q
             if kind == "shape":
                 return np.where(self.lev2, (q_III - q_I) * shape_base * self.t ** k, 0.0) / q_q
+            if kind == "shape_n":
+                return np.where(self.lev2, (q_III - q_I) * shape_base * self.t ** k * self.n, 0.0) / q_q
             if kind in ("fs", "fsp"):
                 return self._finite(kind == "fs", f, k)
         raise KeyError(kind)

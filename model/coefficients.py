@@ -484,6 +484,10 @@ class Coefficients:
     #: W, log-width of the strains the representative stress averages the flow curve over
     #: (``single.representative_stress``); 0: σ_rep = σ_f(ε_rep)
     strain_spread: float = 0.0
+    #: Level II shape terms per unit of the effective hardening exponent (``level_II.H_bar_shape_n``,
+    #: ``c2_shape_n``; empty: none): P(t) = Σ (b_k + bn_k n) t^k
+    H_bar_shape_n: tuple[float, ...] = ()
+    c2_shape_n: tuple[float, ...] = ()
     #: counter-surface coefficients q of H̄_hs and c²_hs (module docstring; 0: none)
     counter_H_bar: float = 0.0
     counter_c2: float = 0.0
@@ -618,6 +622,8 @@ class Coefficients:
             c2_III_exp_poly=_poly(c3, "exp_poly", "c2_III."),
             H_bar_shape=_poly(lev2, "H_bar_shape", "level_II."),
             c2_shape=_poly(lev2, "c2_shape", "level_II."),
+            H_bar_shape_n=_poly(lev2, "H_bar_shape_n", "level_II.") if "H_bar_shape_n" in lev2 else (),
+            c2_shape_n=_poly(lev2, "c2_shape_n", "level_II.") if "c2_shape_n" in lev2 else (),
             exponent_method=method,
             eps_lo=eps_lo,
             eps_hi=eps_hi,
@@ -670,6 +676,8 @@ class Coefficients:
             "finite_size": {"ratio": self.finite_size_ratio, "H_bar": list(self.finite_size_H_bar),
                             "c2": list(self.finite_size_c2)},
         }
+        if self.H_bar_shape_n or self.c2_shape_n:
+            d["level_II"].update(H_bar_shape_n=list(self.H_bar_shape_n), c2_shape_n=list(self.c2_shape_n))
         if self.schema_version >= 2:
             d["level_II"]["smooth"] = self.level_II_smooth
             d["finite_size"]["H_bar_plastic"] = list(self.fs_H_bar_plastic)

@@ -77,12 +77,21 @@ def _poly_and_derivative(t, b: tuple[float, ...]):
     return P, dP
 
 
-def _shape(t, b: tuple[float, ...], smooth: bool = False, m0=0.0):
+def _shape(t, b: tuple[float, ...], smooth: bool = False, m0=0.0, bn: tuple[float, ...] = (), n=0.0):
     """Level II shape s(t) and s'(t) (module docstring of ``coefficients``).
 
     Polynomial: s = t + t(1−t)P(t). Smooth: s = 3t² − 2t³ + m₀(t − 2t² + t³) + t²(1−t)²P(t),
-    with s'(0) = m₀ and s'(1) = 0.
+    with s'(0) = m₀ and s'(1) = 0; P(t) = Σ (b_k + bn_k n) t^k with the hardening exponent n.
     """
+    if bn:
+        m = max(len(b), len(bn))
+        b0 = tuple(b) + (0.0,) * (m - len(b))
+        if np.ndim(n) == 0:
+            b = tuple(x + y * float(n) for x, y in zip(b0, tuple(bn) + (0.0,) * (m - len(bn)), strict=True))
+        else:
+            P0, dP0 = _poly_and_derivative(t, b0)
+            Pn, dPn = _poly_and_derivative(t, tuple(bn))
+            return _shape_with(t, P0 + n * Pn, dP0 + n * dPn, smooth, m0)
     if not smooth:
         if not b:
             return t, np.ones_like(t)
@@ -98,6 +107,16 @@ def _shape(t, b: tuple[float, ...], smooth: bool = False, m0=0.0):
     return s, ds
 
 
+def _shape_with(t, P, dP, smooth: bool, m0):
+    """:func:`_shape` with P(t), P'(t) given (per point)."""
+    if not smooth:
+        return t + t * (1.0 - t) * P, 1.0 + (1.0 - 2.0 * t) * P + t * (1.0 - t) * dP
+    u = 1.0 - t
+    s = t * t * (3.0 - 2.0 * t) + m0 * t * u * u + t * t * u * u * P
+    ds = 6.0 * t * u + m0 * u * (1.0 - 3.0 * t) + 2.0 * t * u * (1.0 - 2.0 * t) * P + t * t * u * u * dP
+    return s, ds
+
+
 def _m0_H(coeffs: Coefficients, H_III):
     """Start slope of the smooth H̄ shape: Hertz's d H̄/d ln Λ = H̄_I, in units of (H̄_III − H̄_I)/L."""
     L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
@@ -105,16 +124,16 @@ def _m0_H(coeffs: Coefficients, H_III):
     return H_I * L / (H_III - H_I)
 
 
-def _level_II(Lambda, q_I, q_III, coeffs: Coefficients, shape, m0=0.0):
+def _level_II(Lambda, q_I, q_III, coeffs: Coefficients, shape, m0=0.0, shape_n=(), n=0.0):
     """q(Λ) in Level II and d q/d ln Λ (t clipped to [0, 1])."""
     L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
     with np.errstate(divide="ignore"):
         t = np.clip(np.log(Lambda / coeffs.Lambda_I) / L, 0.0, 1.0)
-    s, ds = _shape(t, shape, coeffs.level_II_smooth, m0)
+    s, ds = _shape(t, shape, coeffs.level_II_smooth, m0, shape_n, n)
     return q_I + (q_III - q_I) * s, (q_III - q_I) * ds / L
 
 
-def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_III: float):
+def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_III: float, n: float = 0.0):
     """H̄, d ln H̄/d ln Λ, c², d ln c²/d ln Λ and the level index in one pass.
 
     Fast path for one material (Level III values H_III, c2_III given as floats);
@@ -128,8 +147,9 @@ def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_I
         t = np.clip(np.log(Lam / lam1) / L, 0.0, 1.0)
     H_I = coeffs.H_bar_I
     sm = coeffs.level_II_smooth
-    sH_t, dsH_t = _shape(t, coeffs.H_bar_shape, sm, _m0_H(coeffs, H_III) if sm else 0.0)
-    sc_t, dsc_t = _shape(t, coeffs.c2_shape, sm, 0.0)
+    sH_t, dsH_t = _shape(t, coeffs.H_bar_shape, sm, _m0_H(coeffs, H_III) if sm else 0.0,
+                         coeffs.H_bar_shape_n, n)
+    sc_t, dsc_t = _shape(t, coeffs.c2_shape, sm, 0.0, coeffs.c2_shape_n, n)
     H2 = H_I + (H_III - H_I) * sH_t
     c2_2 = C2_HERTZ + (c2_III - C2_HERTZ) * sc_t
     one, two = lev == 1, lev == 2
@@ -149,7 +169,7 @@ def H_bar_and_slope(Lambda, coeffs: Coefficients, n=0.0):
     H_I = coeffs.H_bar_I
     H_III = coeffs.H_bar_III(n)
     m0 = _m0_H(coeffs, H_III) if coeffs.level_II_smooth else 0.0
-    H2, dH2 = _level_II(Lam, H_I, H_III, coeffs, coeffs.H_bar_shape, m0)
+    H2, dH2 = _level_II(Lam, H_I, H_III, coeffs, coeffs.H_bar_shape, m0, coeffs.H_bar_shape_n, n)
     lev = level(Lam, coeffs)
     H = np.where(lev == 1, _HERTZ * Lam, np.where(lev == 2, H2, H_III))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -161,7 +181,7 @@ def c2_and_slope(Lambda, coeffs: Coefficients, n=0.0):
     """c²(Λ) and its log slope d ln c²/d ln Λ (no finite-size factor)."""
     Lam, n = np.broadcast_arrays(np.asarray(Lambda, dtype=float), np.asarray(n, dtype=float))
     c_III = coeffs.c2_III(n)
-    c2_II, dc2_II = _level_II(Lam, C2_HERTZ, c_III, coeffs, coeffs.c2_shape)
+    c2_II, dc2_II = _level_II(Lam, C2_HERTZ, c_III, coeffs, coeffs.c2_shape, 0.0, coeffs.c2_shape_n, n)
     lev = level(Lam, coeffs)
     c = np.where(lev == 1, C2_HERTZ, np.where(lev == 2, c2_II, c_III))
     slope = np.where(lev == 2, dc2_II / c2_II, 0.0)

@@ -320,7 +320,7 @@ class BodyLaw:
             sig, m = representative_stress(mat, eps, co.strain_spread)
             Lam = Ep * x / sig
             m = m * g  # d ln σ_rep/d ln x
-        H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III)
+        H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III, self.n_eff)
         with np.errstate(invalid="ignore"):
             p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
         s_l, ds_l = level_weight(Lam, co)

@@ -129,3 +129,46 @@ def test_calibration_form_with_spread_and_counter_levels_has_exact_jacobian_colu
     co = form.coefficients(x)
     assert co.strain_spread == 1.0 and co.counter_H_bar_plastic == pytest.approx(0.8)
     check_predict_and_jacobian(form, ds, x)
+
+
+def test_level_II_shape_terms_per_hardening_exponent():
+    """level_II.H_bar_shape_n, c2_shape_n: P(t) = Σ (b_k + bn_k n) t^k. Absent: the shape as
+    before; present: Level II moves with n, Levels I and III do not (t²(1 − t)² vanishes there)."""
+    from spherecontact.model import levels
+
+    co = default_coefficients()
+    d = co.to_dict()
+    assert "H_bar_shape_n" not in d["level_II"]
+    d["level_II"].update(H_bar_shape_n=[0.8, -0.5], c2_shape_n=[-0.6, 0.3])
+    co_n = Coefficients.from_dict(d)
+    assert co_n.H_bar_shape_n == (0.8, -0.5) and co_n.to_dict()["level_II"]["c2_shape_n"] == [-0.6, 0.3]
+    lam = np.geomspace(0.5 * co.Lambda_I, 2.0 * co.Lambda_III, 80)
+    for n in (0.0, 0.3):
+        H3, c3 = float(co.H_bar_III(n)), float(co.c2_III(n))
+        H0, sH0, c0, sc0, _ = levels.levels_scalar_n(lam, co, H3, c3, n)
+        H1, sH1, c1, sc1, _ = levels.levels_scalar_n(lam, co_n, H3, c3, n)
+        outside = (lam <= co.Lambda_I) | (lam >= co.Lambda_III)
+        np.testing.assert_array_equal(H1[outside], H0[outside])
+        if n == 0.0:
+            np.testing.assert_array_equal(H1, H0)
+            np.testing.assert_array_equal(c1, c0)
+        else:
+            assert np.abs(H1 / H0 - 1)[~outside].max() > 1e-3
+        # the vectorised form (one n per point) agrees with the scalar one
+        Hv, sHv = levels.H_bar_and_slope(lam, co_n, np.full(lam.size, n))
+        np.testing.assert_allclose(Hv, H1, rtol=1e-12)
+        np.testing.assert_allclose(sHv, sH1, rtol=1e-12, atol=1e-14)
+
+
+def test_calibration_form_with_shape_terms_per_exponent_has_exact_jacobian_columns():
+    form = FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn"]
+    assert form.n_params == FORMS["smooth2_fs2_xn2n_x2_g_csl_w1"].n_params + 4
+    mats = (LUDWIK, VOCE, Material(E=2000.0, nu=0.3, sigma_y=1.0, K=5.0, n=0.5))
+    runs = [(f"s-{Ri}-{i}", as_run(model_result(m, KNOWN_CO, indenter_radius=Ri, n=60)))
+            for Ri in (math.inf, 0.5) for i, m in enumerate(mats)]
+    ds = build_dataset(runs)
+    x = form.start()
+    for name, v in dict(H_shape0=0.2, H_shape_n0=0.3, H_shape_n1=-0.2, c2_shape_n0=0.5,
+                        c2_shape_n1=-0.4, counter_H=-0.6, counter_H3=0.8).items():
+        x[form.names.index(name)] = v
+    check_predict_and_jacobian(form, ds, x)
