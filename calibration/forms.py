@@ -32,9 +32,9 @@ from ..model.single import (
     BodyLaw,
     curvature_ratio,
     effective_exponent,
+    ludwik_representative_stress,
     representative_strain,
     representative_stress,
-    spread_factors,
 )
 from .dataset import Dataset
 
@@ -390,13 +390,9 @@ def _representative_stress(ds: Dataset, beta: float, growth: float, spread: floa
         sy = _per_point(ds, [m.sigma_y if lu else 1.0 for m, lu in zip(mats, ludwik, strict=True)])
         K = _per_point(ds, [m.K if lu else 0.0 for m, lu in zip(mats, ludwik, strict=True)])
         n = _per_point(ds, [m.n if lu else 1.0 for m, lu in zip(mats, ludwik, strict=True)])
-        sig = np.zeros(ds.size)
-        dsig = np.zeros(ds.size)  # Σ w_j ε_j σ_f'(ε_j)
-        for f, w in spread_factors(spread):
-            t = K * (f * eps) ** n
-            sig, dsig = sig + w * (sy + t), dsig + w * n * t
         with np.errstate(invalid="ignore"):
-            m = np.where(np.isfinite(sig), dsig / sig, 0.0)  # 0 for elastic bodies (σ_Y = inf)
+            sig, m = ludwik_representative_stress(sy, K, n, eps, spread)
+        m = np.where(np.isfinite(sig), m, 0.0)  # 0 for elastic bodies (σ_Y = inf)
         for i, mat in enumerate(mats):
             if not ludwik[i]:
                 sel = ds.run == i

@@ -256,15 +256,21 @@ class ContactPass:
         kA = self.weight * k_n * self.area0[rows]
         return dofs, kA * gl[:, None, :] * gl[None, :, :] - lam[rows] * H
 
+    def _reference_interval(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Reference radius of the candidates ``rows`` and the master interval under each of them
+        in the reference state."""
+        r_arc = self.master.hmesh.X[0, self.master_arc]
+        r0 = self.slave.hmesh.X[0, self.candidates[rows]]
+        last = self.ctrl_nodes.shape[1] - 1
+        return r0, np.clip(np.searchsorted(r_arc, r0, side="right") - 1, 0, last)
+
     def window_keys(self, zone: float, width: int) -> np.ndarray:
         """Keys (row · n_dofs + column) of the couplings of every candidate within reference
         radius ``zone`` with the master intervals within ``width`` of the one under it in the
         reference state: a superset of the pairs a run reaching that zone makes."""
-        r_arc = self.master.hmesh.X[0, self.master_arc]
-        r0 = self.slave.hmesh.X[0, self.candidates]
+        r0, seg0 = self._reference_interval(np.arange(self.candidates.size))
         rows = np.flatnonzero(r0 <= zone)
-        last = self.ctrl_nodes.shape[1] - 1
-        seg0 = np.clip(np.searchsorted(r_arc, r0[rows], side="right") - 1, 0, last)
+        seg0, last = seg0[rows], self.ctrl_nodes.shape[1] - 1
         off = np.arange(-width, width + 1)
         seg = np.clip(seg0[:, None] + off, 0, last).ravel()
         dofs = self._pair_dofs(np.repeat(rows, off.size), seg)[0]
@@ -276,9 +282,7 @@ class ContactPass:
         rows = np.flatnonzero(pen)
         if not rows.size:
             return 0.0, 0
-        r_arc = self.master.hmesh.X[0, self.master_arc]
-        r0 = self.slave.hmesh.X[0, self.candidates[rows]]
-        seg0 = np.clip(np.searchsorted(r_arc, r0, side="right") - 1, 0, self.ctrl_nodes.shape[1] - 1)
+        r0, seg0 = self._reference_interval(rows)
         return float(r0.max()), int(np.abs(kin.seg[rows] - seg0).max())
 
     def penalty_tangent(self, kin: Kinematics, k_n: float, pen, lam, G):

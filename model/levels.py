@@ -81,34 +81,13 @@ def _shape(t, b: tuple[float, ...], smooth: bool = False, m0=0.0, bn: tuple[floa
     """Level II shape s(t) and s'(t) (module docstring of ``coefficients``).
 
     Polynomial: s = t + t(1−t)P(t). Smooth: s = 3t² − 2t³ + m₀(t − 2t² + t³) + t²(1−t)²P(t),
-    with s'(0) = m₀ and s'(1) = 0; P(t) = Σ (b_k + bn_k n) t^k with the hardening exponent n.
+    with s'(0) = m₀ and s'(1) = 0; P(t) = Σ (b_k + bn_k n) t^k with the hardening exponent n
+    (a number or one per point).
     """
+    P, dP = _poly_and_derivative(t, b) if b else (0.0, 0.0)
     if bn:
-        m = max(len(b), len(bn))
-        b0 = tuple(b) + (0.0,) * (m - len(b))
-        if np.ndim(n) == 0:
-            b = tuple(x + y * float(n) for x, y in zip(b0, tuple(bn) + (0.0,) * (m - len(bn)), strict=True))
-        else:
-            P0, dP0 = _poly_and_derivative(t, b0)
-            Pn, dPn = _poly_and_derivative(t, tuple(bn))
-            return _shape_with(t, P0 + n * Pn, dP0 + n * dPn, smooth, m0)
-    if not smooth:
-        if not b:
-            return t, np.ones_like(t)
-        P, dP = _poly_and_derivative(t, b)
-        return t + t * (1.0 - t) * P, 1.0 + (1.0 - 2.0 * t) * P + t * (1.0 - t) * dP
-    u = 1.0 - t
-    s = t * t * (3.0 - 2.0 * t) + m0 * t * u * u
-    ds = 6.0 * t * u + m0 * u * (1.0 - 3.0 * t)
-    if b:
-        P, dP = _poly_and_derivative(t, b)
-        s = s + t * t * u * u * P
-        ds = ds + 2.0 * t * u * (1.0 - 2.0 * t) * P + t * t * u * u * dP
-    return s, ds
-
-
-def _shape_with(t, P, dP, smooth: bool, m0):
-    """:func:`_shape` with P(t), P'(t) given (per point)."""
+        Pn, dPn = _poly_and_derivative(t, tuple(bn))
+        P, dP = P + n * Pn, dP + n * dPn
     if not smooth:
         return t + t * (1.0 - t) * P, 1.0 + (1.0 - 2.0 * t) * P + t * (1.0 - t) * dP
     u = 1.0 - t

@@ -61,6 +61,7 @@ from .material import Material
 __all__ = [
     "representative_strain",
     "representative_stress",
+    "ludwik_representative_stress",
     "spread_factors",
     "curvature_ratio",
     "flow_log_slope",
@@ -113,6 +114,16 @@ def spread_factors(spread: float) -> tuple[tuple[float, float], ...]:
     return tuple((math.exp(spread * t), w) for t, w in zip(_GH_NODES, _GH_WEIGHTS, strict=True))
 
 
+def ludwik_representative_stress(sigma_y, K, n, eps, spread: float):
+    """:func:`representative_stress` of Ludwik curves σ_Y + K εⁿ (ε σ_f' = n K εⁿ); the
+    parameters may be arrays shaped like ``eps`` (one curve per point, as the calibration has)."""
+    sig = dsig = 0.0
+    for f, w in spread_factors(spread):
+        t = K * (f * eps) ** n
+        sig, dsig = sig + w * (sigma_y + t), dsig + w * n * t
+    return sig, dsig / sig
+
+
 def representative_stress(material: Material, eps, spread: float = 0.0):
     """σ_rep and m = d ln σ_rep/d ln ε_rep at ε_rep (vectorised): the flow curve averaged over a
     log-normal distribution of strains of log-width W = ``spread`` about ε_rep,
@@ -127,13 +138,8 @@ def representative_stress(material: Material, eps, spread: float = 0.0):
         return material.flow_stress(eps), flow_log_slope(material, eps)
     e = np.maximum(np.asarray(eps, dtype=float), 0.0)
     elastic = material.is_rigid or math.isinf(material.sigma_y)
-    if not (elastic or material.is_tabulated):  # Ludwik σ_Y + K εⁿ: ε σ_f' = n K εⁿ
-        sy, K, n = material.sigma_y, material.K, material.n
-        sig = dsig = 0.0
-        for f, w in spread_factors(spread):
-            t = K * (f * e) ** n
-            sig, dsig = sig + w * (sy + t), dsig + w * n * t
-        return sig, dsig / sig
+    if not (elastic or material.is_tabulated):
+        return ludwik_representative_stress(material.sigma_y, material.K, material.n, e, spread)
     sig = np.zeros_like(e)
     dsig = np.zeros_like(e)  # Σ w_j ε_j σ_f'(ε_j) = ε dσ_rep/dε
     for f, w in spread_factors(spread):
@@ -262,16 +268,6 @@ class BodyLaw:
         s, ds = level_weight(mat.E_prime * x / sig, co)
         return s, ds * (1.0 - m), self.H_bar_III * sig, m
 
-    def _level_at(self, x) -> tuple[np.ndarray, np.ndarray]:
-        """Level weight s at x = a/ρ and ds/d ln x = (ds/d ln Λ)(1 − m) (0 for an elastic body)."""
-        mat, co = self.material, self.coeffs
-        if math.isinf(mat.sigma_y):
-            return np.zeros_like(x), np.zeros_like(x)
-        eps, g = representative_strain(x, co.beta, co.beta_growth)
-        sig, m = representative_stress(mat, eps, co.strain_spread)
-        s, ds = level_weight(mat.E_prime * x / sig, co)
-        return s, ds * (1.0 - m * g)
-
     def _piece(self, Lam, eps, y) -> np.ndarray:
         """Smooth-piece id from the stage of Λ (``levels.stage``: the levels, and the end of the
         unloading onset ramp in Level II), ε_rep (flow-table segment) and y (beyond x_fit_max)."""
@@ -338,7 +334,7 @@ class BodyLaw:
             else:  # u = xc − y moves with a only: every slope in the y slot, the level weight too
                 su, su_x, su_y = counter_surface(np.asarray(xc, dtype=float), y)
                 su_x, su_y = 0.0, su_x + su_y
-                s_c, ds_c = self._level_at(np.asarray(xc, dtype=float))
+                s_c, ds_c = self.plastic_state_at(np.asarray(xc, dtype=float))[:2]
                 lev_x, lev_y = 0.0, ds_c
             (qH, dqH), (qc, dqc) = co.counter_by_level(s_c)  # q(s), dq/ds
             p, c = p * np.exp(qH * su), c * np.exp(qc * su)
