@@ -23,7 +23,7 @@ DB = ROOT / "data" / "reference_v2.h5"
 pytestmark = pytest.mark.skipif(not DB.exists(), reason="data/reference_v2.h5 is not present")
 
 #: a flat, a rigid sphere and a two-body pair of the calibration set
-CASES = ("flat-K5-n1-E100-nu0.3", "rsphere0.88-K1.16-n0.2-E1360-nu0.3", "two-pp-E300-nu0.3-vs-sy4-c0")
+CASES = ("flat-K5-n1-E100-nu0.3", "rsphere0.88-K1.16-n0.2-E1360-nu0.3", "two-pp-E300-nu0.3-vs-sy4")
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +83,7 @@ def test_ekk_limits():
 
 def test_validation_rows_and_failures():
     cases = [c for c in load_cases(DB, "validation")
-             if c.label in ("flat-pp-E250-nu0.3", "two-pp-E200-nu0.3-vs-sy5-c0")]
+             if c.label in ("flat-pp-E250-nu0.3", "two-pp-E200-nu0.3-vs-sy5")]
     assert len(cases) == 2
     rows = unloading_rows(cases)
     assert len(rows) == 8
