@@ -265,7 +265,8 @@ def _plot(runs: dict, outdir: Path) -> str:
     ax[0].set(xlabel="per-body approach h/R", ylabel="F/(σY R²)", title="equal pair, EPP E/σY = 200")
     hz = runs["hertz_d2"]
     ax[1].plot(_curve(hz, "a"), _curve(hz, "h1") / _curve(hz, "h2"), "b.-", label="FE h₁/h₂")
-    ax[1].axhline((600 / 0.96) / (200 / 0.91), color="k", ls=":", label="E'₂/E'₁")
+    ax[1].axhline(HERTZ_PAIR["material2"].E_prime / HERTZ_PAIR["material"].E_prime, color="k", ls=":",
+                  label="E'₂/E'₁")
     ax[1].set(xlabel="a/R₁", ylabel="h₁/h₂", title="elastic E₂/E₁ = 3, R₂/R₁ = 2")
     st, rg = runs["stiff_two_body"], runs["stiff_rigid"]
     ax[2].plot(_curve(rg, "h"), _curve(rg, "F"), "k-", label="rigid sphere")
