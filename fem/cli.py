@@ -21,7 +21,7 @@ import numpy as np
 from ..model.material import Material
 from .assembly import ELEMENTS
 from .io import SCENES, check_inputs, run_indentation, write_run
-from .mesh import DENSITY_RANGE, EDGE_BAND_MAX
+from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN
 from .solver import PENALTY_SCALES, SolverOptions
 
 __all__ = ["register", "run_command", "render_command", "read_flow_table", "material_from_args",
@@ -171,7 +171,8 @@ def run_command(args: argparse.Namespace) -> int:
     checked = check_inputs(material, args.radius, args.h_max, args.indenter_radius,
                            args.mesh_density, args.element, options, radius2=radius2,
                            material2=material2, scene=args.scene.replace("-", "_"),
-                           unload_at=args.unload_at, edge_band=args.edge_band)
+                           unload_at=args.unload_at, edge_band=args.edge_band,
+                           band_floor=args.band_floor)
     print(f"scene: {checked['scene']} ({SCENES[checked['scene']]})", file=sys.stderr)
     bar = _Progress(args.h_max, args.quiet)
     try:
@@ -180,7 +181,7 @@ def run_command(args: argparse.Namespace) -> int:
                                  element=args.element, options=options, progress=bar,
                                  radius2=radius2, material2=material2,
                                  scene=args.scene.replace("-", "_"), unload_at=args.unload_at,
-                                 edge_band=args.edge_band)
+                                 edge_band=args.edge_band, band_floor=args.band_floor)
     finally:
         bar.close()
     extra = {"entry_point": "spherecontact fem run",
@@ -257,6 +258,10 @@ def _add_numerics(add) -> None:
         help=f"surface band where the contact edge travels: element size = edge-band x distance "
              f"from the pole, in [0, {EDGE_BAND_MAX:g}] (default 0: the default mesh; the reference "
              "campaigns use 0.03, FE scatter 0.7 %% instead of 2.6 %%)")
+    add(grp, "--band-floor", type=float, default=None,
+        help=f"smallest element size of the surface band in units of the smaller radius, in "
+             f"[{BAND_FLOOR_RANGE[0]:g}, {BAND_FLOOR_RANGE[1]:g}] (default {EDGE_BAND_MIN:g}; "
+             "two-body pairs whose partner crushes the finest pole elements take 0.0015)")
     add(grp, "--element", choices=sorted(ELEMENTS), default="q8r",
         help="q8r: 8-node quads, 2x2 reduced integration (default, no locking); "
              "q4: bilinear quads, full integration (locks; for comparison)")

@@ -46,7 +46,7 @@ from ..data import input_key
 from ..model.material import Material
 from .assembly import ELEMENTS
 from .io import material_from_description
-from .mesh import DENSITY_RANGE, EDGE_BAND_MAX
+from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN, check_band_floor
 from .solver import SolverOptions
 
 __all__ = ["PARAMETERS", "SCENES", "Param", "Case", "Campaign", "load_campaign", "parse_campaign"]
@@ -112,6 +112,9 @@ PARAMETERS = {
                           lo_open=False, default=1.0),
     "edge_band": Param("surface element size per unit distance from the pole (0: default mesh)",
                        lo=0, hi=EDGE_BAND_MAX, lo_open=False, default=0.0),
+    "band_floor": Param("smallest element size of the surface band in units of the smaller radius "
+                        "(needs edge_band > 0)", lo=BAND_FLOOR_RANGE[0], hi=BAND_FLOOR_RANGE[1],
+                        lo_open=False, default=EDGE_BAND_MIN),
     "Q_over_sigma_y": Param("Voce saturation of body 1 over σY1: σ_f = σY + K ε_p^n + Q(1 − e^(−b ε_p))",
                             lo=0, hi=1e4, lo_open=False, default=0.0),
     "b": Param("Voce saturation rate of body 1 (ignored when Q = 0)", lo=0, hi=1e5, default=1.0),
@@ -199,7 +202,8 @@ class Case:
         kw = {"material": material_from_description(i["material"]), "radius": i["radius"],
               "h_max": i["h_max"], "density": i["mesh_density"], "element": i["element"],
               "options": SolverOptions(**i["options"], max_wall_s=self.max_wall_s),
-              "edge_band": i.get("edge_band", 0.0), "unload_at": i.get("unload_at")}
+              "edge_band": i.get("edge_band", 0.0), "band_floor": i.get("band_floor"),
+              "unload_at": i.get("unload_at")}
         if self.scene == "two_body":
             kw.update(radius2=i["radius2"], material2=material_from_description(i["material2"]))
         else:
@@ -262,7 +266,7 @@ def _name(p: dict, defaults: dict) -> str:
         if (p["K2_over_sigma_y1"], p["n2"]) != (p["K_over_sigma_y"], p["n"]):
             other.append(_hardening(p["K2_over_sigma_y1"], p["n2"]))
         parts += ["vs", *(other or ["same"])]
-    for key, tag in (("h_max", "h"), ("mesh_density", "d"), ("edge_band", "c")):
+    for key, tag in (("h_max", "h"), ("mesh_density", "d"), ("edge_band", "c"), ("band_floor", "f")):
         if p[key] != defaults.get(key, PARAMETERS[key].default):
             parts.append(f"{tag}{_fmt(p[key])}")
     if p["element"] != defaults.get("element", PARAMETERS["element"].default):
@@ -389,7 +393,7 @@ def _body1(p: dict, curves: dict) -> Material:
 
 def _inputs(p: dict, options: dict, curves: dict | None = None) -> dict:
     """Dimensional inputs of the FE run (what the key hashes). The keys a default run leaves
-    out (edge_band 0, no cycles) are left out, so older runs keep their keys."""
+    out (edge_band 0, the band's default floor, no cycles) are left out, so older runs keep their keys."""
     R, sy = p["radius"], p["sigma_y"]
     E = p["E_over_sigma_y"] * sy
     mat = _body1(p, curves or {}).describe()
@@ -405,6 +409,9 @@ def _inputs(p: dict, options: dict, curves: dict | None = None) -> dict:
         inputs.update(h_max=p["h_max"] * min(R, R_ind), indenter_radius=R_ind)
     if p.get("edge_band", 0.0) > 0:
         inputs["edge_band"] = p["edge_band"]
+    floor = check_band_floor(p.get("band_floor", EDGE_BAND_MIN), p.get("edge_band", 0.0))
+    if floor != EDGE_BAND_MIN:
+        inputs["band_floor"] = floor
     if p.get("cycles"):
         unit = inputs["h_max"] / p["h_max"]
         inputs["unload_at"] = [float(f"{c * unit:.12g}") for c in p["cycles"]

@@ -72,7 +72,7 @@ from ..model.material import Material
 from ..model.sphere import Sphere
 from .assembly import ELEMENTS
 from .contact import RigidObstacle
-from .mesh import DENSITY_RANGE, EDGE_BAND_MAX
+from .mesh import DENSITY_RANGE, EDGE_BAND_MAX, check_band_floor
 from .solver import (
     IndentationSolver,
     RunResult,
@@ -235,7 +235,7 @@ def choose_scene(material, radius, material2=None, radius2=None,
 
 def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
                  element="q8r", options=None, progress=None, radius2=None, material2=None,
-                 scene="auto", unload_at=None, edge_band=0.0) -> dict:
+                 scene="auto", unload_at=None, edge_band=0.0, band_floor=None) -> dict:
     """Validate every input of :func:`run_indentation`; return them normalised.
 
     Raises ValueError naming the parameter and its allowed range.
@@ -278,6 +278,7 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
     if not (math.isfinite(band) and 0.0 <= band <= EDGE_BAND_MAX):
         raise ValueError(f"edge_band must lie in [0, {EDGE_BAND_MAX:g}] (0: no surface band), "
                          f"got {edge_band!r}")
+    floor = check_band_floor(band_floor, band)
     options = SolverOptions() if options is None else options
     if not isinstance(options, SolverOptions):
         raise ValueError(f"options must be a SolverOptions, got {type(options).__name__}")
@@ -286,7 +287,8 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
         raise ValueError("progress must be a callable progress(h) or None")
     unload = check_unload_at(unload_at, h)
     return {"material": material, "radius": R, "h_max": h, "indenter_radius": R_ind,
-            "density": d, "element": element, "edge_band": band, "options": options, "progress": progress,
+            "density": d, "element": element, "edge_band": band, "band_floor": floor,
+            "options": options, "progress": progress,
             "material2": material2, "radius2": R2, "scene": chosen,
             "unload_at": unload if unload.size else None}
 
@@ -326,7 +328,8 @@ def run_indentation(material: Material, radius: float, h_max: float,
                     element: str = "q8r", options: SolverOptions | None = None,
                     progress: Callable[[float], object] | None = None,
                     radius2: float | None = None, material2: Material | None = None,
-                    scene: str = "auto", schedule=None, unload_at=None, edge_band: float = 0.0) -> RunResult:
+                    scene: str = "auto", schedule=None, unload_at=None, edge_band: float = 0.0,
+                    band_floor: float | None = None) -> RunResult:
     """Press a hemisphere of ``radius`` and ``material`` on its partner up to ``h_max``.
 
     Partner: ``indenter_radius`` (rigid flat for inf, else a rigid sphere), or body 2
@@ -341,11 +344,12 @@ def run_indentation(material: Material, radius: float, h_max: float,
     instead of adaptive increments (``IndentationSolver.run``). ``unload_at``: increasing
     approaches in (0, h_max] at which the pair is unloaded until the force vanishes and then
     reloaded (labels in ``curves["branch"]``, summaries in ``cycles``). ``edge_band``: surface
-    element size per unit distance from the pole (``build_mesh``; 0: the default mesh).
+    element size per unit distance from the pole (``build_mesh``; 0: the default mesh);
+    ``band_floor``: the band's smallest element size (None: ``mesh.EDGE_BAND_MIN``).
     Returns the solver's ``RunResult``.
     """
     a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
-                     progress, radius2, material2, scene, unload_at, edge_band)
+                     progress, radius2, material2, scene, unload_at, edge_band, band_floor)
     unload_at = a["unload_at"]
     chosen = a["scene"]
     if chosen == "two_body":
@@ -353,7 +357,7 @@ def run_indentation(material: Material, radius: float, h_max: float,
             raise ValueError("schedule: prescribed increments exist for the one-body scenes only")
         solver = TwoBodySolver(a["material"], a["radius"], a["material2"], a["radius2"],
                                density=a["density"], element=a["element"], options=a["options"],
-                               edge_band=a["edge_band"])
+                               edge_band=a["edge_band"], band_floor=a["band_floor"])
         return solver.run(a["h_max"], progress=a["progress"], unload_at=unload_at)
     h_run, progress = a["h_max"], a["progress"]
     if chosen == "equal_pair_symmetry":
@@ -366,7 +370,7 @@ def run_indentation(material: Material, radius: float, h_max: float,
     solver = IndentationSolver(a["material"], a["radius"],
                                obstacle=RigidObstacle(a["indenter_radius"]),
                                density=a["density"], element=a["element"], options=a["options"],
-                               edge_band=a["edge_band"])
+                               edge_band=a["edge_band"], band_floor=a["band_floor"])
     if schedule is not None and chosen == "equal_pair_symmetry":
         schedule = 0.5 * np.asarray(schedule, dtype=float)
     if unload_at is not None and chosen == "equal_pair_symmetry":

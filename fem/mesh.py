@@ -15,6 +15,7 @@ all-quad meshes with guaranteed minimum quality in ~0.05 s.
 
 from __future__ import annotations
 
+import math
 import signal
 import threading
 from dataclasses import dataclass
@@ -33,6 +34,9 @@ _POLE_DIST = 0.07  # radius of the finest zone around the pole
 #: the optional surface band of ``build_mesh(edge_band=...)``: smallest size (units of the
 #: contact scale), growth of the size with depth below the arc, largest allowed ratio s/d
 EDGE_BAND_MIN = 0.0005
+#: allowed range of a chosen smallest band size (``build_mesh(band_floor=...)``), units of the
+#: contact scale: up to the default mesh's pole size
+BAND_FLOOR_RANGE = (0.0001, 0.003)
 EDGE_BAND_GRADING = 0.3
 EDGE_BAND_MAX = 0.2
 #: node order that reverses a quad's orientation, by nodes per element (corners, then midsides)
@@ -60,6 +64,7 @@ class HemisphereMesh:
     radius: float
     density: float
     edge_band: float = 0.0
+    band_floor: float = EDGE_BAND_MIN
 
     @property
     def n_nodes(self) -> int:
@@ -101,7 +106,7 @@ def _gmsh_initialize(gmsh) -> None:
 
 
 def _gmsh_quad8(radius: float, density: float, linear: bool, contact_scale: float,
-                edge_band: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                edge_band: float = 0.0, band_floor: float = EDGE_BAND_MIN) -> tuple[np.ndarray, np.ndarray]:
     """Run gmsh; return node coordinates (2, n) and quad connectivity (n_per_el, n_el)."""
     import gmsh
 
@@ -153,7 +158,7 @@ def _gmsh_quad8(radius: float, density: float, linear: bool, contact_scale: floa
             fields.append(near)
         if edge_band > 0:  # surface size proportional to the distance from the pole
             band = field.add("MathEval")
-            smallest, ratio = EDGE_BAND_MIN * L / density, edge_band / density
+            smallest, ratio = band_floor * L / density, edge_band / density
             expr = f"Max({smallest}, {ratio} * F{d_pole}) + {EDGE_BAND_GRADING} * F{d_arc}"
             field.setString(band, "F", expr)
             fields.append(band)
@@ -193,7 +198,8 @@ def _gmsh_quad8(radius: float, density: float, linear: bool, contact_scale: floa
 
 
 def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
-               contact_scale: float | None = None, edge_band: float = 0.0) -> HemisphereMesh:
+               contact_scale: float | None = None, edge_band: float = 0.0,
+               band_floor: float | None = None) -> HemisphereMesh:
     """Graded all-quad meshing of the hemisphere's meridian section.
 
     Parameters
@@ -211,6 +217,9 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
         unit depth below the arc); 0 (default) leaves the band out. Where the contact edge
         travels, a node closing adds a ring of nearly full plastic pressure, a step of about
         2 Δs/a in F: a constant s/d keeps that step the same fraction of F at every a.
+    band_floor : the band's smallest size in units of contact_scale (default
+        ``EDGE_BAND_MIN``; range ``BAND_FLOOR_RANGE``). Two deformable bodies take a larger
+        one: the partner's nodes crush pole elements far below the pole size (campaign v2).
     """
     radius = float(radius)
     if not np.isfinite(radius) or radius <= 0:
@@ -219,7 +228,8 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
     scale = radius if contact_scale is None else min(float(contact_scale), radius)
     if not (np.isfinite(edge_band) and 0.0 <= edge_band <= EDGE_BAND_MAX):
         raise ValueError(f"edge_band must lie in [0, {EDGE_BAND_MAX}] (0: off), got {edge_band!r}")
-    Xg, tg = _gmsh_quad8(radius, density, linear, scale, float(edge_band))
+    floor = check_band_floor(band_floor, edge_band)
+    Xg, tg = _gmsh_quad8(radius, density, linear, scale, float(edge_band), floor)
     if linear:
         mesh = skfem.MeshQuad1(Xg, tg)
         basis_mesh = mesh
@@ -244,4 +254,23 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
     axis = np.flatnonzero(np.abs(X[0]) < tol)
     equator = np.flatnonzero(np.abs(X[1] - radius) < tol)
     return HemisphereMesh(mesh=mesh, X=X, surface=surface, axis=axis, equator=equator,
-                          radius=radius, density=density, edge_band=float(edge_band))
+                          radius=radius, density=density, edge_band=float(edge_band),
+                          band_floor=floor)
+
+
+def check_band_floor(band_floor, edge_band: float) -> float:
+    """The surface band's smallest size (None: ``EDGE_BAND_MIN``), checked against
+    ``BAND_FLOOR_RANGE``; a chosen floor needs a band (edge_band > 0)."""
+    if band_floor is None:
+        return EDGE_BAND_MIN
+    lo, hi = BAND_FLOOR_RANGE
+    try:
+        floor = float(band_floor)
+    except (TypeError, ValueError):
+        floor = math.nan
+    if not (np.isfinite(floor) and lo <= floor <= hi):
+        raise ValueError(f"band_floor must lie in [{lo:g}, {hi:g}] (units of the contact scale), "
+                         f"got {band_floor!r}")
+    if not edge_band > 0 and floor != EDGE_BAND_MIN:
+        raise ValueError(f"band_floor = {floor:g} needs a surface band: set edge_band > 0")
+    return floor

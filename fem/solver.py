@@ -756,7 +756,7 @@ class IndentationSolver(CycleLegs):
 
     def __init__(self, material: Material, radius: float = 1.0, obstacle: RigidObstacle | None = None,
                  density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None,
-                 edge_band: float = 0.0):
+                 edge_band: float = 0.0, band_floor: float | None = None):
         if material.is_rigid:
             raise ValueError("the deformable body must not be rigid (E = inf)")
         self.material = material
@@ -765,7 +765,8 @@ class IndentationSolver(CycleLegs):
         self.options = options or SolverOptions()
         self.options.validate()
         t0 = time.perf_counter()
-        self.hmesh = build_mesh(self.radius, density, linear=(element == "q4"), edge_band=edge_band)
+        self.hmesh = build_mesh(self.radius, density, linear=(element == "q4"), edge_band=edge_band,
+                                band_floor=band_floor)
         self.disc = Discretisation(self.hmesh, element)
         self.t_setup = time.perf_counter() - t0
         hm, nd = self.hmesh, self.disc.n_dofs
@@ -1241,7 +1242,7 @@ class IndentationSolver(CycleLegs):
         inputs = {"material": self.material.describe(), "radius": R,
                   "indenter_radius": float(self.obstacle.radius), "h_max": h_max,
                   "mesh_density": self.hmesh.density, "edge_band": self.hmesh.edge_band,
-                  "element": self.disc.element,
+                  "band_floor": self.hmesh.band_floor, "element": self.disc.element,
                   "n_elements": self.disc.n_elements, "n_dofs": self._nd,
                   "options": self.options.as_inputs()}
         inputs["unload_at"] = [float(x) for x in unload]

@@ -304,7 +304,7 @@ class TwoBodySolver(CycleLegs):
 
     def __init__(self, material1: Material, radius1: float, material2: Material, radius2: float,
                  density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None,
-                 edge_band: float = 0.0):
+                 edge_band: float = 0.0, band_floor: float | None = None):
         if material1.is_rigid or material2.is_rigid:
             raise ValueError("both bodies of the two-body scene must be deformable (finite E)")
         self.options = options or SolverOptions()
@@ -312,7 +312,7 @@ class TwoBodySolver(CycleLegs):
         t0 = time.perf_counter()
         R_min = min(radius1, radius2)
         discs = [Discretisation(build_mesh(R, density, linear=(element == "q4"), contact_scale=R_min,
-                                           edge_band=edge_band),
+                                           edge_band=edge_band, band_floor=band_floor),
                                 element) for R in (radius1, radius2)]
         self.t_setup = time.perf_counter() - t0
         self.bodies = [Body(material1, float(radius1), discs[0], 0, False),
@@ -811,7 +811,7 @@ class TwoBodySolver(CycleLegs):
                   "material2": b2.material.describe(), "radius2": b2.radius,
                   "indenter_radius": b2.radius, "h_max": h_max,
                   "mesh_density": b1.hmesh.density, "edge_band": b1.hmesh.edge_band,
-                  "element": b1.disc.element,
+                  "band_floor": b1.hmesh.band_floor, "element": b1.disc.element,
                   "n_elements": b1.disc.n_elements + b2.disc.n_elements, "n_dofs": self.n_dofs,
                   "slave_body": self.slave_index + 1, "options": self.options.as_inputs()}
         return RunResult(inputs=inputs, curves=curves, residuals=residuals,

@@ -108,8 +108,23 @@ def test_cycles_scale_with_the_smaller_radius_and_defaults_keep_old_keys():
     assert case.run_kwargs()["edge_band"] == 0.03
     (plain,) = parse_campaign(HEAD + '[[s]]\nscene = "flat"\nE_over_sigma_y = 100\n').cases
     assert "unload_at" not in plain.inputs and "edge_band" not in plain.inputs
+    assert "band_floor" not in case.inputs and case.run_kwargs()["band_floor"] is None
     with pytest.raises(ValueError, match="cycles must increase"):
         parse_campaign(text.replace("[0.01, 0.1, 0.3]", "[0.1, 0.01]"))
+
+
+def test_a_band_floor_other_than_the_default_names_the_case_and_enters_its_key():
+    pair = HEAD + 'edge_band = 0.03\n[[s]]\nscene = "two_body"\nE_over_sigma_y = 200\nradius2 = 0.333\n'
+    (plain,) = parse_campaign(pair).cases
+    (floored,) = parse_campaign(pair + "band_floor = 0.003\n").cases
+    assert floored.name == plain.name + "-f0.003" and floored.key != plain.key
+    assert floored.inputs["band_floor"] == 0.003 and floored.run_kwargs()["band_floor"] == 0.003
+    (default,) = parse_campaign(pair + "band_floor = 0.0005\n").cases
+    assert default.key == plain.key and default.name == plain.name
+    with pytest.raises(ValueError, match="band_floor"):
+        parse_campaign(pair + "band_floor = 0.01\n")
+    with pytest.raises(ValueError, match="needs a surface band"):
+        parse_campaign(pair.replace("edge_band = 0.03", "edge_band = 0") + "band_floor = 0.003\n")
 
 
 def test_v1_campaign_keys_still_match_its_database():

@@ -97,6 +97,8 @@ BAD = {
     "iterations": (["--E", "200", "--h-max", "0.1", "--max-iterations", "1"], "max_iterations"),
     "tol": (["--E", "200", "--h-max", "0.1", "--tol", "0"], "tol"),
     "edge_band": (["--E", "200", "--h-max", "0.1", "--edge-band", "0.5"], "edge_band"),
+    "band_floor": (["--E", "200", "--h-max", "0.1", "--edge-band", "0.03", "--band-floor", "0.1"],
+                   "band_floor"),
 }
 
 

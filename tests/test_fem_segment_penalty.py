@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from spherecontact.fem.contact import RigidObstacle
-from spherecontact.fem.mesh import build_mesh
+from spherecontact.fem.mesh import EDGE_BAND_MIN, build_mesh
 from spherecontact.fem.segment_penalty import SegmentPenalty
 from spherecontact.fem.solver import SolverOptions
 
@@ -83,6 +83,35 @@ def test_edge_band_keeps_the_surface_size_proportional_to_the_distance_from_the_
     assert m.surface.size > 1.5 * plain.surface.size
     with pytest.raises(ValueError, match="edge_band"):
         build_mesh(1.0, 1.0, edge_band=-0.1)
+
+
+def _smallest_surface_element(m) -> float:
+    X = m.X[:, m.surface]
+    return float(2 * np.hypot(*np.diff(X, axis=1)).min())  # a quadratic edge spans two node gaps
+
+
+def test_band_floor_sets_the_smallest_surface_element_in_units_of_the_contact_scale():
+    default = build_mesh(1.0, 1.0, edge_band=0.03)
+    assert default.band_floor == EDGE_BAND_MIN
+    assert _smallest_surface_element(default) < 2.0 * EDGE_BAND_MIN
+    coarse = build_mesh(1.0, 1.0, edge_band=0.03, band_floor=0.003)
+    assert 0.5 * 0.003 < _smallest_surface_element(coarse) < 1.6 * 0.003
+    # a smaller partner sets the contact scale: the floor scales with it
+    small = build_mesh(1.0, 1.0, contact_scale=0.5, edge_band=0.03, band_floor=0.003)
+    assert 0.5 * 0.0015 < _smallest_surface_element(small) < 1.6 * 0.0015
+    assert coarse.surface.size < default.surface.size
+
+
+@pytest.mark.parametrize("floor, edge_band, message", [
+    (0.01, 0.03, r"band_floor must lie in \[0.0001, 0.003\]"),
+    (0.0, 0.03, "band_floor must lie in"),
+    (float("nan"), 0.03, "band_floor must lie in"),
+    ("thin", 0.03, "band_floor must lie in"),
+    (0.002, 0.0, "needs a surface band: set edge_band > 0"),
+])
+def test_bad_band_floor_is_named_with_its_range(floor, edge_band, message):
+    with pytest.raises(ValueError, match=message):
+        build_mesh(1.0, 1.0, edge_band=edge_band, band_floor=floor)
 
 
 # --------------------------------------------------------------- penalty scaled with the approach
