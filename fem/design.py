@@ -23,7 +23,7 @@ the format.
 A case the FE cannot finish as designed is replaced in a ``[replace]`` table, by
 its name, with a reason and the parameters that change (``h_max``, ``cycles``)::
 
-    [replace."two-pp-E300-nu0.3-vs-sy2-c0"]
+    [replace."two-pp-E300-nu0.3-vs-sy2-f0.0015"]
     h_max = 0.18
     reason = "inverted element at h/R 0.186 (Lagrangian mesh at the contact edge)"
 

@@ -133,6 +133,26 @@ def test_database_pairs_table_and_the_required_pairs():
     assert not _pairs_pass(short)
 
 
+def test_a_pair_on_the_surface_band_takes_its_floor_on_both_bodies():
+    """band_floor reaches both meshes, in units of the smaller radius, and is recorded."""
+    from spherecontact.fem.twobody import TwoBodySolver
+    soft, hard = Material(E=200.0, nu=0.3, sigma_y=1.0), Material(E=200.0, nu=0.3, sigma_y=2.0)
+    fine = TwoBodySolver(soft, 1.0, hard, 0.5, edge_band=0.03)
+    coarse = TwoBodySolver(soft, 1.0, hard, 0.5, edge_band=0.03, band_floor=0.003)
+    for solver, floor in ((fine, 0.0005), (coarse, 0.003)):
+        for body in solver.bodies:
+            m = body.disc.hmesh
+            X = m.X[:, m.surface]
+            smallest = 2 * np.hypot(*np.diff(X, axis=1)).min()  # a quadratic edge: two node gaps
+            assert m.band_floor == floor and 0.5 * floor * 0.5 < smallest < 1.6 * floor * 0.5
+    assert coarse.n_dofs < fine.n_dofs
+    res = run_indentation(soft, 1.0, 0.002, radius2=0.5, material2=hard, edge_band=0.03,
+                          band_floor=0.003, density=0.5)
+    assert res.status == "converged" and res.inputs["band_floor"] == 0.003
+    with pytest.raises(ValueError, match="band_floor"):
+        run_indentation(soft, 1.0, 0.002, radius2=0.5, material2=hard, edge_band=0.03, band_floor=1.0)
+
+
 def test_the_softer_sphere_is_the_slave_of_one_pass_contact():
     """One pass: the lower yield stress, then the lower E', then the smaller sphere, body 1 on
     a tie; two passes (penalty) keep the smaller sphere."""
