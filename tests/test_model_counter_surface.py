@@ -147,7 +147,7 @@ def check_predict_and_jacobian(form, ds, x, columns=None, atol: float = 2e-5) ->
 
 def test_calibration_form_fits_them_with_exact_jacobian_columns():
     form = FORMS["smooth2_fs2_xn2n_x2_g_cs"]
-    assert form.name in CANDIDATES
+    assert all(FORMS[n].has_counter for n in CANDIDATES if n != "seed")  # every candidate has them
     assert form.n_params == FORMS["smooth2_fs2_xn2n_x2_g"].n_params + 2
     assert form.names[-2:] == ["counter_H", "counter_c2"]
     runs = [(f"sphere-{Ri}", as_run(model_result(LUDWIK, KNOWN_CO, indenter_radius=Ri, n=60)))
@@ -195,8 +195,9 @@ def test_an_inconsistent_partition_is_an_error_not_a_value():
     """Beyond h/R ≈ 0.36 two elastic–perfectly plastic spheres whose pressures no longer depend
     on the partition can leave the κ equation without a single root: the state found then has
     h₁ + h₂ ≠ h, or the inversion does not converge. The model raises, naming the approach,
-    instead of returning a state (here from h/R = 0.45 on; 7 of 300 random plastic pairs of
-    radius ratio 0.25–4 and yield ratio 1–2.5 raise somewhere in h/R 0.31–0.5, none below)."""
+    instead of returning a state (here from h/R = 0.48 on; 5 of 300 random plastic pairs of
+    radius ratio 0.25–4, yield ratio 1–2.5 and E ratio 0.3–3 raise somewhere in h/R 0.35–0.49,
+    none below)."""
     import numpy as np
     import pytest
 
@@ -207,5 +208,5 @@ def test_an_inconsistent_partition_is_an_error_not_a_value():
     h_ok = 0.39056 * np.linspace(0.01, 0.3, 100)
     ok = contact(s1, s2, h_ok)  # inside the calibrated h/R
     np.testing.assert_allclose(ok.h1 + ok.h2, h_ok, rtol=1e-9)
-    with pytest.raises(ValueError, match=r"(no consistent root|did not converge).* at h = 0\.17"):
+    with pytest.raises(ValueError, match=r"(no consistent root|did not converge).* at h = 0\.18"):
         contact(s1, s2, 0.39056 * np.linspace(0.01, 0.5, 400))

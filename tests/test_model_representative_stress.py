@@ -136,9 +136,11 @@ def test_level_II_shape_terms_per_hardening_exponent():
     before; present: Level II moves with n, Levels I and III do not (t²(1 − t)² vanishes there)."""
     from spherecontact.model import levels
 
-    co = default_coefficients()
-    d = co.to_dict()
-    assert "H_bar_shape_n" not in d["level_II"]
+    d = default_coefficients().to_dict()
+    for key in ("H_bar_shape_n", "c2_shape_n"):  # the shipped form may carry them: start without
+        d["level_II"].pop(key, None)
+    co = Coefficients.from_dict(d)
+    assert co.H_bar_shape_n == () and co.c2_shape_n == ()
     d["level_II"].update(H_bar_shape_n=[0.8, -0.5], c2_shape_n=[-0.6, 0.3])
     co_n = Coefficients.from_dict(d)
     assert co_n.H_bar_shape_n == (0.8, -0.5) and co_n.to_dict()["level_II"]["c2_shape_n"] == [-0.6, 0.3]
