@@ -261,7 +261,8 @@ def _add_numerics(add) -> None:
     add(grp, "--band-floor", type=float, default=None,
         help=f"smallest element size of the surface band in units of the smaller radius, in "
              f"[{BAND_FLOOR_RANGE[0]:g}, {BAND_FLOOR_RANGE[1]:g}] (default {EDGE_BAND_MIN:g}; "
-             "two-body pairs whose partner crushes the finest pole elements take 0.0015)")
+             "campaign v2's two-body pairs whose partner crushes the finest pole elements take "
+             "0.0015 or 0.003)")
     add(grp, "--element", choices=sorted(ELEMENTS), default="q8r",
         help="q8r: 8-node quads, 2x2 reduced integration (default, no locking); "
              "q4: bilinear quads, full integration (locks; for comparison)")

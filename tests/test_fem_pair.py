@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _meshes import smallest_surface_element
 
 from spherecontact.fem.io import choose_scene, read_run, run_indentation, write_run
 from spherecontact.fem.segments import gap_gradient, gap_hessian
@@ -137,14 +138,14 @@ def test_a_pair_on_the_surface_band_takes_its_floor_on_both_bodies():
     """band_floor reaches both meshes, in units of the smaller radius, and is recorded."""
     from spherecontact.fem.twobody import TwoBodySolver
     soft, hard = Material(E=200.0, nu=0.3, sigma_y=1.0), Material(E=200.0, nu=0.3, sigma_y=2.0)
-    fine = TwoBodySolver(soft, 1.0, hard, 0.5, edge_band=0.03)
-    coarse = TwoBodySolver(soft, 1.0, hard, 0.5, edge_band=0.03, band_floor=0.003)
+    R_min = 0.5
+    fine = TwoBodySolver(soft, 1.0, hard, R_min, edge_band=0.03)
+    coarse = TwoBodySolver(soft, 1.0, hard, R_min, edge_band=0.03, band_floor=0.003)
     for solver, floor in ((fine, 0.0005), (coarse, 0.003)):
         for body in solver.bodies:
             m = body.disc.hmesh
-            X = m.X[:, m.surface]
-            smallest = 2 * np.hypot(*np.diff(X, axis=1)).min()  # a quadratic edge: two node gaps
-            assert m.band_floor == floor and 0.5 * floor * 0.5 < smallest < 1.6 * floor * 0.5
+            smallest = smallest_surface_element(m)
+            assert m.band_floor == floor and 0.5 * floor * R_min < smallest < 1.6 * floor * R_min
     assert coarse.n_dofs < fine.n_dofs
     res = run_indentation(soft, 1.0, 0.002, radius2=0.5, material2=hard, edge_band=0.03,
                           band_floor=0.003, density=0.5)

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from _meshes import smallest_surface_element
 
 from spherecontact.fem.contact import RigidObstacle
 from spherecontact.fem.mesh import EDGE_BAND_MIN, build_mesh
@@ -85,20 +86,15 @@ def test_edge_band_keeps_the_surface_size_proportional_to_the_distance_from_the_
         build_mesh(1.0, 1.0, edge_band=-0.1)
 
 
-def _smallest_surface_element(m) -> float:
-    X = m.X[:, m.surface]
-    return float(2 * np.hypot(*np.diff(X, axis=1)).min())  # a quadratic edge spans two node gaps
-
-
 def test_band_floor_sets_the_smallest_surface_element_in_units_of_the_contact_scale():
     default = build_mesh(1.0, 1.0, edge_band=0.03)
     assert default.band_floor == EDGE_BAND_MIN
-    assert _smallest_surface_element(default) < 2.0 * EDGE_BAND_MIN
+    assert smallest_surface_element(default) < 2.0 * EDGE_BAND_MIN
     coarse = build_mesh(1.0, 1.0, edge_band=0.03, band_floor=0.003)
-    assert 0.5 * 0.003 < _smallest_surface_element(coarse) < 1.6 * 0.003
+    assert 0.5 * 0.003 < smallest_surface_element(coarse) < 1.6 * 0.003
     # a smaller partner sets the contact scale: the floor scales with it
     small = build_mesh(1.0, 1.0, contact_scale=0.5, edge_band=0.03, band_floor=0.003)
-    assert 0.5 * 0.0015 < _smallest_surface_element(small) < 1.6 * 0.0015
+    assert 0.5 * 0.0015 < smallest_surface_element(small) < 1.6 * 0.0015
     assert coarse.surface.size < default.surface.size
 
 
