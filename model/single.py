@@ -33,9 +33,9 @@ c² = c²_hs^(1−w_c) c²_c(y, n, z)^(w_c), and
     ∂ln p_m = (1 − w) ∂ln p_hs + w (∂ln σ_rep + ∂ln H̄_c),
     ∂ln c²  = (1 − w_c) ∂ln c²_hs + w_c ∂ln c²_c + (ln c²_c − ln c²_hs) k_c w_c (1 − w_c) ∂ln r.
 
-z is the curvature ratio R/ρ_H − 1 of the body with ρ_H its Hertz (Level I) relative
-radius, a constant of the pair (:func:`curvature_ratio`): 0 for equal spheres (flat
-interface), R/R_i against a rigid sphere of radius R_i. Being constant it leaves
+z is the curvature ratio R/ρ_c − 1 of the body with ρ_c the radius of the surface that
+presses it, a constant of the pair (:func:`curvature_ratio`; ``unified.harder_partner_weight``):
+0 for equal spheres (flat interface), R/R_i against a rigid sphere of radius R_i. Being constant it leaves
 p_m(x) monotone in 1/ρ, so the κ solve keeps a single root.
 """
 

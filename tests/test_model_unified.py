@@ -1,11 +1,19 @@
 """Unified two-sphere model (DESIGN §3): Hertz limit, scene limits, symmetry, inputs."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
 
-from spherecontact.model import Material, Sphere, contact, contact_from_radius
+from spherecontact.model import (
+    CalibrationRangeWarning,
+    Material,
+    Sphere,
+    contact,
+    contact_from_radius,
+    load_coefficients,
+)
 from spherecontact.model.coefficients import LITERATURE, Coefficients
 from spherecontact.model.single import indent
 from spherecontact.model.unified import UnifiedPair
@@ -229,3 +237,23 @@ def test_inversion_of_many_approaches_equals_one_at_a_time(name):
     one = np.array([p._invert(h[i:i + 1])[0][0] for i in range(h.size)])
     assert np.max(np.abs(a / one - 1.0)) <= 1e-12
     assert np.max(np.abs(p.state_at_a(a).h / h - 1.0)) <= 1e-13
+
+
+def test_a_much_harder_partner_presses_like_a_rigid_sphere_of_its_radius():
+    """Body 1's collapse limits read the curvature ratio of the surface that presses it,
+    z = R₁/ρ_c − 1, with ρ_c moved from the Hertz partition towards R* by the harder partner's
+    weight (``unified.harder_partner_weight``), as the counter-surface terms are. An EPP sphere
+    pressed by an equal sphere of 20 times its yield stress then has the contact radius of the
+    same sphere on a rigid sphere of that radius at the same h₁, to within body 2's elastic
+    flattening (0.9 / 0.6 % at h/R 0.2 / 0.3). With the Hertz partition's z = 0 (equal E and
+    radii: a flat interface) a was 4.7 % below it at h/R = 0.3, and the FE's yield-ratio-5 pair
+    7.7 % below the FE."""
+    co = load_coefficients()
+    s1 = Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=1.0))
+    hard = Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=20.0))
+    h = np.array([0.2, 0.3])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)  # yield ratio 20
+        st = contact(s1, hard, h, co)
+        rigid = contact(s1, Sphere(1.0, Material.rigid()), st.h1, co)
+    np.testing.assert_allclose(st.a / rigid.a, 1.0, atol=0.015)
