@@ -519,11 +519,11 @@ HARDER_PARTNER_EXPONENT = 4.0
 
 def harder_partner_weight(s: Sphere, partner: Sphere) -> float:
     """Weight w of the rigid-partner geometry in the radius ρ_c of the surface pressing body ``s``:
-    1/ρ_c = (1 − w)/ρ_H + w/R* (``BodyLaw.response``'s xc = a/ρ_c and z = R/ρ_c − 1). w = 2·max(r^k/(1 + r^k) − ½, 0)
-    with r = σ_Y of the partner over σ_Y of ``s`` and k = ``HARDER_PARTNER_EXPONENT``: 0 for a
-    partner no harder (the Hertz partition), → 1 for a much harder one, which the body sees as a
-    rigid sphere of its radius (a/ρ_c − a/R = a/R_partner). A constant of the pair, so the κ
-    equation stays monotone in u."""
+    1/ρ_c = (1 − w)/ρ_H + w/R* (``BodyLaw.response``'s xc = a/ρ_c and z = R/ρ_c − 1).
+    w = 2·max(r^k/(1 + r^k) − ½, 0) with r = σ_Y of the partner over σ_Y of ``s`` and
+    k = ``HARDER_PARTNER_EXPONENT``: 0 for a partner no harder (the Hertz partition), → 1 for a
+    much harder one, which the body sees as a rigid sphere of its radius (a/ρ_c − a/R =
+    a/R_partner). A constant of the pair, so the κ equation stays monotone in u."""
     if partner.is_rigid or s.is_rigid:
         return 0.0
     ys, yp = s.material.sigma_y, partner.material.sigma_y
