@@ -14,7 +14,8 @@ Free parameters of a form (bounds in :func:`Form.parameters`):
 * optional collapse blend (``collapse``): ln H̄_c prefactor, exponent, x-polynomial,
   n-polynomial, ln c²_c prefactor, x-polynomial, n-polynomial, z-polynomials, ln of the
   sharpness k; optionally x·n terms of both limits (``n_collapse_xnH``, ``n_collapse_xnc``)
-  and a separate sharpness k_c and offset s of the c² weight (``c2_sharpness``, ``c2_offset``).
+  and a separate sharpness k_c and offset s of the c² weight (``c2_sharpness``, ``c2_offset``);
+  optionally z·n terms of both limits (``n_collapse_znH``, ``n_collapse_znc``).
 """
 
 from __future__ import annotations
@@ -67,6 +68,8 @@ class Form:
     n_collapse_zc: int = 1      # ... of c²_c
     n_collapse_xnH: int = 0     # xn_poly (x·n) terms of H̄_c
     n_collapse_xnc: int = 0     # ... of c²_c
+    n_collapse_znH: int = 0     # zn_poly (z·n) terms of H̄_c
+    n_collapse_znc: int = 0     # ... of c²_c
     c2_sharpness: bool = False  # separate sharpness k_c of the c² weight
     c2_offset: bool = False     # offset s of the c² weight, w_c = (r e^s)^k_c/(1 + (r e^s)^k_c)
     ratio: str = "a_over_R"     # finite-size ratio
@@ -114,6 +117,8 @@ class Form:
             p += [(f"Hc_xn{k}", 0.0, -5.0, 5.0) for k in range(self.n_collapse_xnH)]
             # like c²_c's x-polynomial: n Σ_k e_k (x − X_C2)^(k+1)
             p += [(f"c2c_xn{k}", 0.0, -6.0, 6.0) for k in range(self.n_collapse_xnc)]
+            p += [(f"Hc_zn{k}", 0.0, -3.0, 3.0) for k in range(self.n_collapse_znH)]
+            p += [(f"c2c_zn{k}", 0.0, -3.0, 3.0) for k in range(self.n_collapse_znc)]
             if self.c2_sharpness:
                 p += [("ln_sharpness_c2", math.log(2.0), math.log(0.5), math.log(30.0))]
             if self.c2_offset:
@@ -195,11 +200,13 @@ class Form:
                           "x_poly": seq("Hc_x", self.n_collapse_H),
                           "exp_poly": seq("Hc_n", self.n_collapse_nH),
                           "z_poly": seq("Hc_z", self.n_collapse_zH),
-                          "xn_poly": seq("Hc_xn", self.n_collapse_xnH)},
+                          "xn_poly": seq("Hc_xn", self.n_collapse_xnH),
+                          **({"zn_poly": seq("Hc_zn", self.n_collapse_znH)} if self.n_collapse_znH else {})},
                 "c2": {"prefactor": math.exp(v["ln_c2c"] + shifted[0]), "exponent": 0.0,
                        "x_poly": [float(c) for c in shifted[1:]],
                        "exp_poly": c_n,
-                       "z_poly": seq("c2c_z", self.n_collapse_zc), "xn_poly": c_xn},
+                       "z_poly": seq("c2c_z", self.n_collapse_zc), "xn_poly": c_xn,
+                       **({"zn_poly": seq("c2c_zn", self.n_collapse_znc)} if self.n_collapse_znc else {})},
                 "sharpness": math.exp(v["ln_sharpness"]),
             }
             if self.c2_sharpness:
@@ -224,7 +231,7 @@ class Form:
 def _limit(d: dict) -> CollapseLimit:
     return CollapseLimit(prefactor=d["prefactor"], exponent=d["exponent"], x_poly=tuple(d["x_poly"]),
                          exp_poly=tuple(d["exp_poly"]), z_poly=tuple(d["z_poly"]),
-                         xn_poly=tuple(d["xn_poly"]))
+                         xn_poly=tuple(d["xn_poly"]), zn_poly=tuple(d.get("zn_poly", ())))
 
 
 def _unchecked(d: dict) -> Coefficients:
@@ -513,6 +520,14 @@ FORMS["smooth2_fs2_xn2n_x2_g_csl_w1"] = _derived(
 FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn"] = _derived(
     "smooth2_fs2_xn2n_x2_g_csl_w1", "smooth2_fs2_xn2n_x2_g_csl_w1_sn", "as smooth2_fs2_xn2n_x2_g_csl_w1, "
     "Level II shape terms changing with the hardening exponent", n_shape_n=2)
+FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn"] = _derived(
+    "smooth2_fs2_xn2n_x2_g_csl_w1_sn", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn", "as "
+    "smooth2_fs2_xn2n_x2_g_csl_w1_sn, collapse limits with a z·n term (the pressing surface's "
+    "curvature acting with the hardening exponent)", n_collapse_znH=1, n_collapse_znc=1)
+FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_z2"] = _derived(
+    "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_z2", "as "
+    "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn, both collapse limits quadratic in z", n_collapse_zH=2,
+    n_collapse_zc=2)
 FORMS["smooth2_fs2_xn2n_x3_g_csl_w1"] = _derived(
     "smooth2_fs2_xn2n_x2_g_csl_w1", "smooth2_fs2_xn2n_x3_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl_w1, both "
     "collapse limits cubic in a/R", n_collapse_H=3, n_collapse_c=3)
@@ -526,4 +541,5 @@ FORMS["smooth2_fs2_xn2n_x3_g_csl_w1"] = _derived(
 #: forms they beat stay in FORMS for ``--forms``; so does the same with cubic collapse limits
 #: (_x3_g_csl_w1: E_cv 1.70 %, but its F(h) fails the monotonicity check, which cost the
 #: calibration 12 s a run as a candidate).
-CANDIDATES = ("seed", "smooth2_fs2_xn2n_x2_g_csl_w1", "smooth2_fs2_xn2n_x2_g_csl_w1_sn")
+CANDIDATES = ("seed", "smooth2_fs2_xn2n_x2_g_csl_w1_sn", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn",
+              "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_z2")

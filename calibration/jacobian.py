@@ -46,7 +46,7 @@ _REL_STEP = math.sqrt(np.finfo(float).eps)
 #: indexed parameter families (name = family + index k)
 _FAMILIES = ("H_III_n", "c2_III_n", "H_shape", "c2_shape", "H_shape_n", "c2_shape_n", "fs_H", "fs_c2",
              "fsp_H", "fsp_c2",
-             "Hc_x", "Hc_n", "Hc_z", "Hc_xn", "c2c_x", "c2c_n", "c2c_z", "c2c_xn")
+             "Hc_x", "Hc_n", "Hc_z", "Hc_xn", "Hc_zn", "c2c_x", "c2c_n", "c2c_z", "c2c_xn", "c2c_zn")
 
 
 #: the half-space parameter families of H̄ and c² and what they are (``_Parts._level_values``)
@@ -236,11 +236,13 @@ def _collapse_basis(parts: _Parts, base: str, k: int):
         "Hc_n": ("H", lambda: n ** (k + 1)),
         "Hc_z": ("H", lambda: z ** (k + 1)),
         "Hc_xn": ("H", lambda: n * y ** (k + 1)),
+        "Hc_zn": ("H", lambda: n * z ** (k + 1)),
         "ln_c2c": ("c", lambda: one),
         "c2c_x": ("c", lambda: (y - X_C2) ** (k + 1)),
         "c2c_n": ("c", lambda: n ** (k + 1)),
         "c2c_z": ("c", lambda: z ** (k + 1)),
         "c2c_xn": ("c", lambda: n * (y - X_C2) ** (k + 1)),
+        "c2c_zn": ("c", lambda: n * z ** (k + 1)),
     }
     if base not in table:
         return None

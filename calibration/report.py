@@ -335,8 +335,10 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
     H3, c3, l2 = co["H_bar_III"], co["c2_III"], co["level_II"]
     L.append(f"| H̄_III(n) | {_fmt(H3['prefactor'])} · exp(Σ {_fmt(H3['exp_poly'])} n^k) |")
     L.append(f"| c²_III(n) | {_fmt(c3['prefactor'])} · exp(Σ {_fmt(c3['exp_poly'])} n^k) |")
+    per_n = (f"; per unit of n: H̄ {_fmt(l2['H_bar_shape_n'])}, c² {_fmt(l2['c2_shape_n'])}"
+             if l2.get("H_bar_shape_n") else "")
     L.append(f"| Level II | smooth = {l2['smooth']}, H̄ shape {_fmt(l2['H_bar_shape'])}, "
-             f"c² shape {_fmt(l2['c2_shape'])} |")
+             f"c² shape {_fmt(l2['c2_shape'])}{per_n} |")
     fs = co["finite_size"]
     L.append(f"| finite size ({fs['ratio']}), 1 + Σ f_k x^k | Level I: H̄ {_fmt(fs['H_bar'])}, c² "
              f"{_fmt(fs['c2'])}; Level III: H̄ {_fmt(fs['H_bar_plastic'])}, c² {_fmt(fs['c2_plastic'])} |")
@@ -345,9 +347,10 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
         for key, lab in (("H_bar", "collapse H̄_c"), ("c2", "collapse c²_c")):
             lim = col[key]
             xn = f" + n Σ {_fmt(lim['xn_poly'])} x^k" if lim.get("xn_poly") else ""
+            zn = f" + n Σ {_fmt(lim['zn_poly'])} z^k" if lim.get("zn_poly") else ""
             L.append(f"| {lab} | {_fmt(lim['prefactor'])} x^−{_fmt(lim['exponent'])} "
                      f"exp(Σ {_fmt(lim['x_poly'])} x^k + Σ {_fmt(lim['exp_poly'])} n^k{xn} "
-                     f"+ Σ {_fmt(lim['z_poly'])} z^k) |")
+                     f"+ Σ {_fmt(lim['z_poly'])} z^k{zn}) |")
         L.append(f"| sharpness k | {_fmt(col['sharpness'])} |")
         if "sharpness_c2" in col:
             L.append(f"| sharpness k_c of the c² weight | {_fmt(col['sharpness_c2'])} |")

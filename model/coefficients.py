@@ -24,9 +24,10 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
 * large-deformation collapse (schema 2, optional; same ratio x): the half-space values
   H̄_hs, c²_hs above are blended with limits of the whole body,
   L(x, n, z) = prefactor · x^(−exponent) · exp(Σ_k x_poly[k] x^(k+1) + Σ_k exp_poly[k] n^(k+1)
-  + n Σ_k xn_poly[k] x^(k+1) + Σ_k z_poly[k] z^(k+1)), z = R/ρ_H − 1 with ρ_H the body's
-  Hertz relative radius (a constant of the pair: 0 for equal spheres, R/R_i against a rigid
-  sphere); ``xn_poly`` (optional, default none) lets the x-dependence vary with n,
+  + n Σ_k xn_poly[k] x^(k+1) + Σ_k z_poly[k] z^(k+1) + n Σ_k zn_poly[k] z^(k+1)),
+  z = R/ρ_c − 1 with ρ_c the radius of the surface pressing the body (a constant of the pair:
+  0 for equal spheres, R/R_i against a rigid sphere); ``xn_poly`` and ``zn_poly`` (optional,
+  default none) let the x- and z-dependence vary with n,
   r = H̄_hs/H̄_c,  w = r^k/(1 + r^k)  (k = sharpness),
   w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c))  (the c² weight: k_c = sharpness_c2 and
   s = offset_c2, both optional, default k and 0, so that w_c = w),
@@ -335,8 +336,8 @@ def _choice(d: dict, key: str, where: str, allowed: tuple[str, ...]) -> str:
 
 
 def _limit(d, where: str) -> CollapseLimit:
-    """A collapse limit {prefactor, exponent, x_poly, exp_poly, z_poly[, xn_poly]} (module
-    docstring); ``xn_poly`` is optional (absent: none)."""
+    """A collapse limit {prefactor, exponent, x_poly, exp_poly, z_poly[, xn_poly, zn_poly]}
+    (module docstring); ``xn_poly`` and ``zn_poly`` are optional (absent: none)."""
     if not isinstance(d, dict):
         raise ValueError(f"coefficients: '{where}' must be an object, got {type(d).__name__}")
     pre = _number(d, "prefactor", where + ".")
@@ -346,7 +347,8 @@ def _limit(d, where: str) -> CollapseLimit:
                          x_poly=_poly(d, "x_poly", where + "."),
                          exp_poly=_poly(d, "exp_poly", where + "."),
                          z_poly=_poly(d, "z_poly", where + "."),
-                         xn_poly=_poly(d, "xn_poly", where + ".") if "xn_poly" in d else ())
+                         xn_poly=_poly(d, "xn_poly", where + ".") if "xn_poly" in d else (),
+                         zn_poly=_poly(d, "zn_poly", where + ".") if "zn_poly" in d else ())
 
 
 def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
@@ -385,15 +387,32 @@ def _poly_and_slope(x, poly: tuple[float, ...]):
     return s, ds
 
 
+def _z_terms(z, z_max: float | None, poly: tuple[float, ...]):
+    """Σ poly[k] z^(k+1) and its z-derivative, continued beyond z_max in ln(1 + z)."""
+    zc = z if z_max is None else np.minimum(z, z_max)
+    sz = np.zeros_like(zc)  # Σ c_k z^(k+1)
+    dz = np.zeros_like(zc)  # Σ (k+1) c_k z^k
+    for k in range(len(poly) - 1, -1, -1):
+        sz = (sz + poly[k]) * zc
+        dz = dz * zc + (k + 1) * poly[k]
+    if z_max is None or not poly or not np.any(z > z_max):
+        return sz, dz
+    S = (1.0 + zc) * dz  # d/d ln(1 + z) at z_c
+    u = (1.0 + zc) / (1.0 + np.maximum(z, z_max))
+    beyond = z > z_max
+    return (np.where(beyond, sz + S * (1.0 - u), sz),
+            np.where(beyond, S * u / (1.0 + np.maximum(z, z_max)), dz))
+
+
 @dataclass(frozen=True)
 class CollapseLimit:
     """L(x, n, z) = prefactor · x^(−exponent)
     · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1) + n Σ xn_poly[k] x^(k+1)
-    + Σ z_poly[k] z^(k+1)).
+    + Σ z_poly[k] z^(k+1) + n Σ zn_poly[k] z^(k+1)).
 
-    x: finite-size ratio, n: effective hardening exponent, z = R/ρ_H − 1: curvature of the
-    surface pressing the body relative to the body's own, with ρ_H the Hertz relative
-    radius E'R*/E* (0 for equal spheres; R/R_i against a rigid sphere of radius R_i).
+    x: finite-size ratio, n: effective hardening exponent, z = R/ρ_c − 1: curvature of the
+    surface pressing the body relative to the body's own (0 for equal spheres; R/R_i against
+    a rigid sphere of radius R_i; ``unified.harder_partner_weight``).
     """
 
     prefactor: float
@@ -402,6 +421,7 @@ class CollapseLimit:
     exp_poly: tuple[float, ...] = ()
     z_poly: tuple[float, ...] = ()
     xn_poly: tuple[float, ...] = ()
+    zn_poly: tuple[float, ...] = ()
 
     def log_and_slope(self, x, n=0.0, z=0.0, x_max: float | None = None,
                       z_max: float | None = None):
@@ -410,8 +430,8 @@ class CollapseLimit:
 
         Beyond the fitted ranges the terms are continued C¹ to constants
         (:func:`continue_beyond`): the x-dependence g(x) = −exponent ln x + Σ … beyond
-        ``x_max`` in ln x, the z-dependence Σ z_poly[k] z^(k+1) beyond ``z_max`` (≥ 0) in
-        ln(1 + z) = ln(R/ρ_H)."""
+        ``x_max`` in ln x, the z-dependence Σ z_poly[k] z^(k+1) (and n Σ zn_poly[k] z^(k+1))
+        beyond ``z_max`` (≥ 0) in ln(1 + z) = ln(R/ρ_c)."""
         x = np.asarray(x, dtype=float)
         z = np.asarray(z, dtype=float)
         xc, u = continue_beyond(x, x_max)
@@ -422,27 +442,15 @@ class CollapseLimit:
             s, ds = s + n_ * sn, ds + n_ * dsn
         if x_max is not None:
             s, ds = s + (ds - self.exponent) * (1.0 - u), ds * u + self.exponent * (1.0 - u)
-        sz, dz = self._z_terms(z, z_max)
+        sz, dz = _z_terms(z, z_max, self.z_poly)
+        if self.zn_poly:
+            szn, dzn = _z_terms(z, z_max, self.zn_poly)
+            n_ = np.asarray(n, dtype=float)
+            sz, dz = sz + n_ * szn, dz + n_ * dzn
         with np.errstate(divide="ignore"):  # x = 0 (a flat body): ln L = +inf, or finite if exponent 0
             power = self.exponent * np.log(xc) if self.exponent else 0.0
             lnL = math.log(self.prefactor) - power + s + sz + np.log(_exp_poly(1.0, self.exp_poly, n))
         return lnL, ds - self.exponent, dz
-
-    def _z_terms(self, z, z_max: float | None):
-        """Σ z_poly[k] z^(k+1) and its z-derivative, continued beyond z_max in ln(1 + z)."""
-        zc = z if z_max is None else np.minimum(z, z_max)
-        sz = np.zeros_like(zc)  # Σ c_k z^(k+1)
-        dz = np.zeros_like(zc)  # Σ (k+1) c_k z^k
-        for k in range(len(self.z_poly) - 1, -1, -1):
-            sz = (sz + self.z_poly[k]) * zc
-            dz = dz * zc + (k + 1) * self.z_poly[k]
-        if z_max is None or not self.z_poly or not np.any(z > z_max):
-            return sz, dz
-        S = (1.0 + zc) * dz  # d/d ln(1 + z) at z_c
-        u = (1.0 + zc) / (1.0 + np.maximum(z, z_max))
-        beyond = z > z_max
-        return (np.where(beyond, sz + S * (1.0 - u), sz),
-                np.where(beyond, S * u / (1.0 + np.maximum(z, z_max)), dz))
 
     def __call__(self, x, n=0.0, z=0.0):
         return np.exp(self.log_and_slope(x, n, z)[0])
@@ -450,7 +458,8 @@ class CollapseLimit:
     def to_dict(self) -> dict:
         return {"prefactor": self.prefactor, "exponent": self.exponent,
                 "x_poly": list(self.x_poly), "exp_poly": list(self.exp_poly),
-                "z_poly": list(self.z_poly), "xn_poly": list(self.xn_poly)}
+                "z_poly": list(self.z_poly), "xn_poly": list(self.xn_poly),
+                **({"zn_poly": list(self.zn_poly)} if self.zn_poly else {})}
 
 
 @dataclass(frozen=True)

@@ -61,6 +61,7 @@ _REFINEMENTS = 3
 _ONE_SIDED = 1e-8  # offset in ln a for the one-sided slopes at kinks
 _KINK_TOL = 1e-11  # kink location tolerance in ln a
 _KINK_POINTS = 1024  # points per pass of the kink search, shared by the kinks (≥ 16 each)
+_KINKS_PER_STEP = 8  # searches of one grid interval for further piece changes after the first
 _PROBES = (0.21, 0.5, 0.79)  # error probes: fractions of every interval in ln a
 _SAFETY = 2.0      # error bound = safety × largest error found at the probe points
 _BELOW = 2.0       # grid steps of the grid's bottom below the Hertz radius of h_min
@@ -290,25 +291,46 @@ class ContactLaw:
 
     def _find_kinks(self, grid: np.ndarray, st: UnifiedState) -> np.ndarray:
         """ln(a/R*) of every piece change of the pair between grid nodes inside the table
-        (``self._lnX``), by multi-section: one vectorised κ solve per pass (and the pieces,
-        :meth:`_pieces`), warm-started by u interpolated between the ends of each bracket
-        (u = ln(ρ_2/ρ_1) of the last pass; the grid's Hermite in the first)."""
+        (``self._lnX``), by multi-section (:meth:`_first_changes`). A grid interval can hold
+        more than one change (a flow table's nodes crossed by the representative stress's three
+        strains come closer than the grid step at large a): while the piece just above the change
+        found differs from the piece at the interval's upper node, the rest of the interval is
+        searched again."""
         lo_end, hi_end = self._lnX
         piece = st.piece
         j = np.nonzero((piece[1:] != piece[:-1]) & (grid[1:] > lo_end) & (grid[:-1] < hi_end))[0]
         if j.size == 0:
             return np.empty(0)
-        lo, hi = grid[j], grid[j + 1]
+        lo, hi, p_lo, p_hi = grid[j], grid[j + 1], piece[j], piece[j + 1]
         u = self._u_of(st)
         u_lo, u_hi = (None, None) if u is None else (u[j], u[j + 1])
-        p_lo = piece[j][:, None]
+        found = []
+        for _ in range(_KINKS_PER_STEP):
+            kink, p_kink, u_kink = self._first_changes(lo, hi, p_lo, u_lo, u_hi)
+            found.append(kink)
+            more = p_kink != p_hi
+            if not more.any():
+                break
+            lo, hi, p_lo, p_hi = kink[more], hi[more], p_kink[more], p_hi[more]
+            if u is not None:
+                u_lo, u_hi = u_kink[more], u_hi[more]
+        kinks = np.sort(np.concatenate(found))
+        return kinks[(kinks > lo_end) & (kinks < hi_end)]
+
+    def _first_changes(self, lo, hi, p_lo, u_lo, u_hi):
+        """The first piece change above ``lo`` in each bracket [lo, hi] whose lower end has the
+        piece ``p_lo``, to ``_KINK_TOL``: one vectorised κ solve per pass (and the pieces,
+        :meth:`_pieces`), warm-started by u interpolated between the ends of each bracket
+        (u = ln(ρ_2/ρ_1) of the last pass; the grid's Hermite in the first). Returns the point
+        just above each change, its piece and u there (None for scenes without a κ solve)."""
+        p_lo = p_lo[:, None]
         n = _sections(float(np.max(hi - lo)), lo.size)
         frac = np.arange(1, n) / n
         rows = np.arange(lo.size)
         first_pass = True
         while np.max(hi - lo) > _KINK_TOL:
             pts = lo[:, None] + (hi - lo)[:, None] * frac[None, :]
-            if u is None:
+            if u_lo is None:
                 guess = None
             elif first_pass:
                 guess = self._u_at(pts.ravel())
@@ -321,11 +343,12 @@ class ContactLaw:
             below, above = np.maximum(first - 1, 0), np.minimum(first, frac.size - 1)
             keep_lo, keep_hi = first == 0, first == frac.size
             lo, hi = np.where(keep_lo, lo, pts[rows, below]), np.where(keep_hi, hi, pts[rows, above])
-            if u is not None:
+            if u_lo is not None:
                 up = up.reshape(pts.shape)
                 u_lo = np.where(keep_lo, u_lo, up[rows, below])
                 u_hi = np.where(keep_hi, u_hi, up[rows, above])
-        return hi[(hi > lo_end) & (hi < hi_end)]
+        p_hi, u_at = self._pieces(hi, u_hi)
+        return hi, p_hi, u_at
 
     def _u_of(self, st: UnifiedState):
         """u = ln(ρ_2/ρ_1) of solved states (None if the pair needs no κ solve)."""
