@@ -97,6 +97,9 @@ SUPPORTED_VERSIONS = (1, 2)
 ENV_VAR = "SPHERECONTACT_COEFFICIENTS"
 SOURCES = ("literature", "calibration")
 RATIOS = ("a_over_rho", "a_over_R")
+#: variables of the collapse limits' z-polynomials (``collapse.z_variable``): z itself, or
+#: ln(1 + max(z, 0)) = ln(R/ρ_c) (0 for z ≤ 0, where no calibration run lies)
+Z_VARIABLES = ("z", "ln(1+z)")
 EXPONENT_METHODS = ("secant_loglog",)
 
 #: Built-in literature set (schema 1): the starting values of calibration and the fallback
@@ -488,6 +491,7 @@ class Coefficients:
     collapse_sharpness: float = 0.0
     collapse_sharpness_c2: float | None = None  # None: the same as collapse_sharpness
     collapse_offset_c2: float | None = None     # None: 0
+    collapse_z_variable: str = "z"              # one of Z_VARIABLES
     level_II_smooth: bool = False
     beta_growth: float = 0.0  # γ of ε_rep = β x (1 + γ x); 0: the linear ε_rep = β x
     #: W, log-width of the strains the representative stress averages the flow curve over
@@ -577,6 +581,7 @@ class Coefficients:
         if not isinstance(refs, dict):
             raise ValueError("coefficients: 'references' must be an object")
         cH = cc = kc = sc = None
+        zvar = "z"
         k = 0.0
         smooth = False
         fsHp = fscp = None
@@ -613,6 +618,8 @@ class Coefficients:
                                          f"got {kc!r}")
                 if "offset_c2" in col:
                     sc = _number(col, "offset_c2", "collapse.")
+                if "z_variable" in col:
+                    zvar = _choice(col, "z_variable", "collapse.", Z_VARIABLES)
                 if cH.exponent <= 0.0:
                     raise ValueError("coefficients: 'collapse.H_bar.exponent' must be > 0 (the limit "
                                      f"must vanish as the ratio -> 0), got {cH.exponent!r}")
@@ -646,6 +653,7 @@ class Coefficients:
             collapse_sharpness=k,
             collapse_sharpness_c2=kc,
             collapse_offset_c2=sc,
+            collapse_z_variable=zvar,
             level_II_smooth=smooth,
             beta_growth=growth, strain_spread=spread,
             **interface,
@@ -698,6 +706,8 @@ class Coefficients:
                 d["collapse"]["sharpness_c2"] = self.collapse_sharpness_c2
             if self.has_collapse and self.collapse_offset_c2 is not None:
                 d["collapse"]["offset_c2"] = self.collapse_offset_c2
+            if self.has_collapse and self.collapse_z_variable != "z":
+                d["collapse"]["z_variable"] = self.collapse_z_variable
         d["references"] = copy.deepcopy(self.references)
         return d
 
@@ -728,6 +738,13 @@ class Coefficients:
         Beyond it they are continued C¹ to constants (``levels.continue_beyond``), so F(h)
         and a(h) stay finite and increasing however far the approach goes."""
         return self.calibrated_range.a_over_R_max
+
+    def collapse_z(self, z):
+        """The variable of the collapse limits' z-polynomials at curvature ratio z
+        (``collapse_z_variable``): z, or ln(1 + max(z, 0)) (vectorised)."""
+        if self.collapse_z_variable == "z":
+            return z
+        return np.log1p(np.maximum(np.asarray(z, dtype=float), 0.0))
 
     @property
     def z_fit_max(self) -> float:

@@ -214,7 +214,8 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     x : finite-size ratio (a/R or a/ρ), > 0.
     coeffs : coefficient set; without a collapse block the inputs are returned (w = 0).
     n : effective hardening exponent.
-    z : R/ρ − 1, curvature of the pressing surface relative to the body (0: flat interface).
+    z : R/ρ − 1, curvature of the pressing surface relative to the body (0: flat interface);
+        the limits' z-polynomials read ``coeffs.collapse_z(z)`` (``collapse.z_variable``).
 
     Log derivatives of the result follow from those of the inputs:
     d ln H̄ = (1 − w) d ln H̄_hs + w d ln H̄_c and
@@ -226,9 +227,13 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     zero = np.zeros_like(H_hs)
     if not coeffs.has_collapse:
         return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero, zero, zero, zero)
-    xm, zm = coeffs.x_fit_max, coeffs.z_fit_max
-    lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, z, xm, zm)
-    lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, z, xm, zm)
+    xm, zm = coeffs.x_fit_max, coeffs.collapse_z(coeffs.z_fit_max)
+    zv = coeffs.collapse_z(z)  # the z-polynomials' variable (``collapse.z_variable``)
+    lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, zv, xm, zm)
+    lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, zv, xm, zm)
+    if coeffs.collapse_z_variable != "z":  # d/dz = d/dζ · dζ/dz, ζ = ln(1 + max(z, 0))
+        dzeta = np.where(z > 0.0, 1.0 / (1.0 + np.maximum(z, 0.0)), 0.0)
+        zHc, zcc = zHc * dzeta, zcc * dzeta
     H, c, w, gap, wc = blend_from_logs(H_hs, c2_hs, lnHc, lncc, coeffs.collapse_sharpness,
                                        coeffs.collapse_sharpness_c2, coeffs.collapse_offset_c2)
     return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero, wc)

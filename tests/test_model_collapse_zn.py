@@ -88,3 +88,52 @@ def test_form_writes_the_key_and_its_jacobian_columns_are_exact():
             for Ri in (math.inf, 2.0, 1.0)]  # z = 0, 0.5, 1: within the fitted z
     ds = build_dataset(runs)
     check_predict_and_jacobian(FORM, ds, x, columns=j, atol=1e-5)
+
+
+def test_z_variable_key_round_trips_and_names_bad_values():
+    d = v2(ZN).to_dict()
+    assert "z_variable" not in d["collapse"]  # the default, z, is not written
+    d["collapse"]["z_variable"] = "ln(1+z)"
+    co = Coefficients.from_dict(d)
+    assert co.collapse_z_variable == "ln(1+z)"
+    assert Coefficients.from_dict(co.to_dict()) == co
+    d["collapse"]["z_variable"] = "log"
+    with pytest.raises(ValueError, match=re.escape("'collapse.z_variable'")):
+        Coefficients.from_dict(d)
+
+
+def test_log_variable_reads_ln_R_over_rho_and_is_constant_below_z_0():
+    """With ``z_variable`` ln(1+z) the limits read ζ = ln(1 + max(z, 0)) = ln(R/ρ_c): the body's
+    limits against a rigid sphere of radius R_i are those of the z form at ζ = ln(1 + R/R_i),
+    and a body pressed by a surface flatter than its own (z < 0, a stiffer partner; no calibration
+    run lies there) keeps the limits of z = 0."""
+    from spherecontact.model import levels
+
+    d = v2(ZN).to_dict()
+    d["collapse"]["z_variable"] = "ln(1+z)"
+    log_co, lin_co = Coefficients.from_dict(d), v2(ZN)
+    x, n = np.geomspace(0.05, 0.7, 6), 0.3
+    H_hs, c_hs = np.full(6, 3.0), np.full(6, 1.2)
+    for z in (0.25, 0.5, 1.0):  # within the default set's fitted z (beyond, the continuations differ)
+        a = levels.collapse_blend(H_hs, c_hs, x, log_co, n, z)
+        b = levels.collapse_blend(H_hs, c_hs, x, lin_co, n, math.log1p(z))
+        np.testing.assert_allclose(a.H_bar, b.H_bar, rtol=1e-14)
+        np.testing.assert_allclose(a.c2, b.c2, rtol=1e-14)
+        np.testing.assert_allclose(a.dlnc2c_dz, b.dlnc2c_dz / (1.0 + z), rtol=1e-12)
+    flat = levels.collapse_blend(H_hs, c_hs, x, log_co, n, 0.0)
+    for z in (-0.5, -0.99):
+        below = levels.collapse_blend(H_hs, c_hs, x, log_co, n, z)
+        assert below.c2.tolist() == flat.c2.tolist() and np.all(below.dlnc2c_dz == 0.0)
+
+
+def test_log_form_writes_the_key_and_its_jacobian_columns_are_exact():
+    form = FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz"]
+    x = form.start()
+    names = ["Hc_z0", "c2c_z0", "Hc_zn0", "c2c_zn0"]
+    j = [form.names.index(n) for n in names]
+    x[j] = (0.2, -0.4, -0.3, 0.6)
+    assert form.to_dict(x)["collapse"]["z_variable"] == "ln(1+z)"
+    hard = Material(E=500.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)
+    runs = [(f"sphere-{Ri}", as_run(model_result(hard, KNOWN_CO, indenter_radius=Ri, n=60)))
+            for Ri in (math.inf, 2.0, 1.0)]
+    check_predict_and_jacobian(form, build_dataset(runs), x, columns=j, atol=1e-5)
