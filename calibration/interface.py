@@ -121,8 +121,14 @@ def _with(coeffs: Coefficients, radius: float, exponent: float, coupling: float 
                                interface_radius=radius, interface_exponent=exponent)
 
 
-def fit_interface(pairs, coeffs: Coefficients) -> InterfaceFit | None:
-    """Grid search of a_c/R* × k (module docstring); None without pairs.
+def _grid_point(_ds, pairs, coeffs: Coefficients, radius: float, exponent: float) -> dict[str, float]:
+    """:func:`split_errors` of ``pairs`` at one grid point (a task of ``calibration.workers``)."""
+    return split_errors(pairs, _with(coeffs, radius, exponent))
+
+
+def fit_interface(pairs, coeffs: Coefficients, pool=None) -> InterfaceFit | None:
+    """Grid search of a_c/R* × k (module docstring); None without pairs. ``pool``: a
+    ``workers.Workers`` the grid points are spread over (the same result in the same order).
 
     Score: the largest split error over the pairs, then (ties within 0.1 percentage point) the
     mean of the pairs' largest errors; further ties go to the first grid point. Pairs the
@@ -134,13 +140,15 @@ def fit_interface(pairs, coeffs: Coefficients) -> InterfaceFit | None:
     probe = split_errors(pairs, _with(coeffs, RADII[0], EXPONENTS[0]))
     moved = [c for c in pairs if abs(probe[c.name] - none[c.name]) > 1e-9]
     fixed = {c.name: none[c.name] for c in pairs if c not in moved}
+    grid = [(r, k) for r in RADII for k in EXPONENTS]
+    tasks = [(moved, coeffs, r, k) for r, k in grid]
+    done = pool.map(_grid_point, tasks) if pool is not None else [_grid_point(None, *t) for t in tasks]
     best = None
-    for r in RADII:
-        for k in EXPONENTS:
-            e = fixed | split_errors(moved, _with(coeffs, r, k))
-            score = (round(max(e.values()), 3), float(np.mean(list(e.values()))))
-            if best is None or score < best[0]:
-                best = (score, r, k, e)
+    for (r, k), moved_errors in zip(grid, done, strict=True):
+        e = fixed | moved_errors
+        score = (round(max(e.values()), 3), float(np.mean(list(e.values()))))
+        if best is None or score < best[0]:
+            best = (score, r, k, e)
     _, r, k, e = best
     e = {c.name: e[c.name] for c in pairs}
     if not math.isfinite(max(e.values())) or max(e.values()) >= max(none.values()):

@@ -109,6 +109,12 @@ def test_grid_search_recovers_the_anchor_it_was_given():
     f = fit_interface(pairs, dataclasses.replace(CO, interface_coupling=0.0))
     assert (f.radius, f.exponent) == (RADII[3], EXPONENTS[1])
     assert max(f.errors.values()) < 1e-9 < min(f.errors_none.values())
+    # the grid spread over two worker processes gives the same fit, error for error
+    from spherecontact.calibration.workers import Workers
+
+    with Workers(None, 2) as pool:
+        g = fit_interface(pairs, dataclasses.replace(CO, interface_coupling=0.0), pool)
+    assert (g.radius, g.exponent, g.errors, g.errors_none) == (f.radius, f.exponent, f.errors, f.errors_none)
 
 
 def test_pairs_of_clearly_unequal_hardness_skip_the_coupling():
