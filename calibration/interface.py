@@ -121,6 +121,14 @@ def _with(coeffs: Coefficients, radius: float, exponent: float, coupling: float 
                                interface_radius=radius, interface_exponent=exponent)
 
 
+def with_interface(coeffs: Coefficients, fitted: InterfaceFit | None) -> Coefficients:
+    """``coeffs`` with the fitted interface terms (unchanged without a fit or when the terms were
+    left out, coupling 0)."""
+    if fitted is None or fitted.coupling <= 0.0:
+        return coeffs
+    return dataclasses.replace(coeffs, **{f"interface_{k}": v for k, v in fitted.section().items()})
+
+
 def _grid_point(_ds, pairs, coeffs: Coefficients, radius: float, exponent: float) -> dict[str, float]:
     """:func:`split_errors` of ``pairs`` at one grid point (a task of ``calibration.workers``)."""
     return split_errors(pairs, _with(coeffs, radius, exponent))

@@ -37,7 +37,7 @@ from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
-from .interface import InterfaceFit, fit_interface, load_pairs, two_body_runs
+from .interface import InterfaceFit, fit_interface, load_pairs, two_body_runs, with_interface
 from .threads import single_threaded_blas
 from .unloading import H_RES_WEIGHT, TAIL, UnloadingFit, fit_unloading
 from .workers import DEFAULT_WORKERS, Workers
@@ -160,14 +160,6 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
         timings["unloading_s"] = time.perf_counter() - t
     timings["total_s"] = time.perf_counter() - t0
     return cal
-
-
-def with_interface(co: Coefficients, fitted: InterfaceFit | None) -> Coefficients:
-    """``co`` with the fitted interface terms (unchanged without them or when they were left
-    out, coupling 0)."""
-    if fitted is None or fitted.coupling <= 0.0:
-        return co
-    return dataclasses.replace(co, **{f"interface_{k}": v for k, v in fitted.section().items()})
 
 
 def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,

@@ -746,6 +746,13 @@ class Coefficients:
             return z
         return np.log1p(np.maximum(np.asarray(z, dtype=float), 0.0))
 
+    def collapse_z_slope(self, z):
+        """d :meth:`collapse_z`/dz: 1, or 1/(1 + z) for z > 0 and 0 below (vectorised)."""
+        z = np.asarray(z, dtype=float)
+        if self.collapse_z_variable == "z":
+            return np.ones_like(z)
+        return np.where(z > 0.0, 1.0 / (1.0 + np.maximum(z, 0.0)), 0.0)
+
     @property
     def z_fit_max(self) -> float:
         """Largest curvature ratio z = R/ρ_H − 1 the collapse limits' z-terms were fitted on:

@@ -231,8 +231,8 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     zv = coeffs.collapse_z(z)  # the z-polynomials' variable (``collapse.z_variable``)
     lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, zv, xm, zm)
     lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, zv, xm, zm)
-    if coeffs.collapse_z_variable != "z":  # d/dz = d/dζ · dζ/dz, ζ = ln(1 + max(z, 0))
-        dzeta = np.where(z > 0.0, 1.0 / (1.0 + np.maximum(z, 0.0)), 0.0)
+    if coeffs.collapse_z_variable != "z":  # d/dz = d/dζ · dζ/dz
+        dzeta = coeffs.collapse_z_slope(z)
         zHc, zcc = zHc * dzeta, zcc * dzeta
     H, c, w, gap, wc = blend_from_logs(H_hs, c2_hs, lnHc, lncc, coeffs.collapse_sharpness,
                                        coeffs.collapse_sharpness_c2, coeffs.collapse_offset_c2)

@@ -201,20 +201,20 @@ class UnifiedPair:
         # w): the counter-surface ratio a/ρ_c and the collapse limits' curvature ratio
         # z_i = R_i/ρ_c − 1 (constants of the pair, so the κ root stays unique)
         self._z = {}
-        self._inv_rho_h = {}  # 1/ρ_c of each body (``_body``)
+        self._inv_rho_c = {}  # 1/ρ_c of each body (``_body``)
         for law, s_, s_o in ((self.law1, s1, s2), (self.law2, s2, s1)):
             if law is None:
                 continue
             rho_h = self.R_star if s_o.is_rigid else s_.material.E_prime * self.R_star / self.E_star
             w = harder_partner_weight(s_, s_o)
-            self._inv_rho_h[id(law)] = (1.0 - w) / rho_h + w / self.R_star
-            self._z[id(law)] = curvature_ratio(s_.radius, 1.0 / self._inv_rho_h[id(law)])
+            self._inv_rho_c[id(law)] = (1.0 - w) / rho_h + w / self.R_star
+            self._z[id(law)] = curvature_ratio(s_.radius, 1.0 / self._inv_rho_c[id(law)])
 
     # ------------------------------------------------------------------ body responses
     def _body(self, law: BodyLaw, a, k, R) -> BodyResponse:
         x = a * k
         y = x if self._ratio_rho else a / R
-        return law.response(x, y, self._z[id(law)], a * self._inv_rho_h[id(law)])
+        return law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)])
 
     def _g(self, a, u, C=0.0, uA=0.0):
         """g = ln p_1 − ln p_2 + C (u − u_A) at (a, u), its u-derivative, and both responses
