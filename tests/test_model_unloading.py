@@ -160,6 +160,16 @@ def test_a_peak_in_level_one_leaves_no_residual_approach(co):
     np.testing.assert_allclose(contact(s1, WALL, h, h_max=h_el).F, contact(s1, WALL, h).F, rtol=1e-12)
 
 
+def test_a_yielded_body_below_lambda_one_leaves_a_residual_approach(co):
+    """A soft, strongly hardening sphere (Ludwik K/σ_Y 10, n 0.6, E/σ_Y 10) on a flat: its σ_rep
+    keeps Johnson's Λ below Λ_I to h/R = 0.3, yet the FE leaves h_res/h_max = 0.135 there. The
+    onset reads Λ_u with √(σ_Y σ_rep) (``unloading.onset_Lambda_u``); with σ_rep it gave 0."""
+    s1 = Sphere(1.0, Material(E=10.0, nu=0.3, sigma_y=1.0, K=10.0, n=0.6))
+    st = pair(s1, WALL, co).state_from_h(np.array([0.3]))
+    assert st.Lambda1[0] < co.Lambda_I
+    assert 0.1 < residual_approach(s1, WALL, 0.3) / 0.3 < 0.16
+
+
 def test_residual_approach_grows_with_the_largest_approach(co):
     for s2 in (WALL, Sphere(1.0, EPP), Sphere(0.5, HARD)):
         hm = np.geomspace(1e-5, 0.3, 60)
