@@ -207,10 +207,15 @@ class UnloadingCoefficients:
     elastic_weight: float = 1.0
     #: g_U: a curved counter-surface (U = u/(1 + u)) scales the size terms of g_i by (1 − g_U U)
     size_counter: float = 0.0
-    #: s_c: the stiffness of a plastic peak grows by (c²)^(s_c (1 − w)) (pile-up stiffer, sink-in softer)
+    #: s_c: the stiffness of a plastic peak grows by (c²)^q, q = s_c (1 − w) + s_U U + s_z z̄ + s_2 ln c²
+    #: (pile-up stiffer, sink-in softer)
     stiffness_c2: float = 0.0
     #: m_λ: the plastic exponent grows by m_λ λ against a flat
     m_lambda: float = 0.0
+    #: s_U, s_z, s_2 of the pile-up exponent q (curved counter-surface, depth, ln c² itself)
+    stiffness_c2_counter: float = 0.0
+    stiffness_c2_depth: float = 0.0
+    stiffness_c2_c2: float = 0.0
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in UNLOADING_RANGES}
@@ -222,9 +227,12 @@ UNLOADING_RANGES = {"stiffness": (0.5, 2.0), "size_a": (0.0, 10.0), "size_h": (0
                     "m_plastic": (1.0, 2.0), "m_c2": (-1.0, 1.0), "m_depth": (-2.0, 2.0),
                     "m_counter": (1.0, 2.0),
                     "m_elastic_size": (-1.0, 3.0), "elastic_weight": (0.1, 20.0),
-                    "size_counter": (0.0, 1.0), "stiffness_c2": (-0.5, 0.5), "m_lambda": (-1.0, 1.0)}
+                    "size_counter": (0.0, 1.0), "stiffness_c2": (-0.5, 0.5), "m_lambda": (-1.0, 1.0),
+                    "stiffness_c2_counter": (-2.0, 2.0), "stiffness_c2_depth": (-2.0, 2.0),
+                    "stiffness_c2_c2": (-2.0, 2.0)}
 #: keys of the ``unloading`` section an older file may leave out (absent: 0, the law without them)
-UNLOADING_OPTIONAL = ("size_counter", "stiffness_c2", "m_lambda")
+UNLOADING_OPTIONAL = ("size_counter", "stiffness_c2", "m_lambda", "stiffness_c2_counter",
+                      "stiffness_c2_depth", "stiffness_c2_c2")
 
 #: allowed ranges of the ``interface`` section's numbers
 _INTERFACE_RANGES = {"coupling": (0.0, 1000.0), "similarity": (0.01, 10.0), "radius": (0.01, 100.0),

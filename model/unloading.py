@@ -20,8 +20,10 @@ more conforming residual profile). The law here (``UnloadingCoefficients``):
   and its own approach at the peak over its radius; the stiffening of a squat body falls with ν,
   and with the curvature of the contact surface: a body dented by a rigid sphere of its own
   size is not flattened like one pressed by a flat — without g_U the FE's deep rigid-sphere
-  peaks, a/R* ≈ 0.9, unload up to 15 % softer than the law), P = (c²)^(s_c (1 − w)) (a
-  plastic peak with pile-up, c² > 1, unloads stiffer than one that sinks in);
+  peaks, a/R* ≈ 0.9, unload up to 15 % softer than the law), P = (c²)^q with
+  q = s_c (1 − w) + s_U U + s_z z̄ + s_2 ln c² (a plastic peak with pile-up, c² > 1, unloads
+  stiffer than one that sinks in; less so under a curved counter-surface, when deep, or with
+  much pile-up: ``PILE_UP_TERMS``);
   δ_e = m F_max C/s₀ with C = Σ C_i;
 * m = (1 − w)[(1 − U)(m_p + m_c2 ln c² + m_depth z̄ + m_λ λ) + U m_counter] + w (3/2 + m_el ȳ²),
   clipped to [1, 3], with the elastic weight w = min(λ, 1)^k, λ = p_m/p_Hertz(a) =
@@ -56,13 +58,20 @@ from .levels import onset_ramp
 from .unified import UnifiedPair, UnifiedState
 
 __all__ = ["EXPONENT_RANGE", "Peak", "PeakFeatures", "features", "peak_features",
-           "unloading_law", "peak_parameters", "branch", "work_returned", "onset_Lambda_u"]
+           "unloading_law", "peak_parameters", "branch", "work_returned", "onset_Lambda_u",
+           "PILE_UP_TERMS"]
 
 # ``levels.ONSET``: the level weight at which the residual approach has grown from 0 (Level I)
 # to the law's value (FE cycles at weights 1e-4 / 1e-3 / 4e-3 left 0 / 4 / 3 % of h_max;
 # ONSET = 1e-2 raised the validation branches above 3 % from 8 to 12)
 #: the unloading exponent is kept in this range (F stays increasing and C¹ at h_res)
 EXPONENT_RANGE = (1.0, 3.0)
+
+#: the pile-up exponent's terms s_U U + s_z z̄ + s_2 ln c² beside s_c (1 − w) (measured in
+#: model/README.md, "Unloading"): the deepest cycles of perfectly plastic spheres under rigid
+#: spheres of R_i ≈ R keep c² > 1 while the body flattens to a/R ≈ 0.6, and s_c (1 − w) alone
+#: left them 11–14 % too stiff
+PILE_UP_TERMS = ("stiffness_c2_counter", "stiffness_c2_depth", "stiffness_c2_c2")
 
 #: q of the onset's stress σ_Y^q σ_rep^(1−q) (:func:`onset_Lambda_u`). A strongly hardening body
 #: whose σ_rep keeps up with E'a/ρ stays below Λ_I by Johnson's Λ although it has yielded: read
@@ -154,11 +163,13 @@ def unloading_law(f: PeakFeatures, co: UnloadingCoefficients):
     w = f.lam ** co.elastic_weight
     size = ((co.size_a * f.y**2 + co.size_h * f.z) * (1.0 + co.size_nu * (f.nu - 0.3))
             * (1.0 - co.size_counter * f.U[:, None]))
-    pile_up = np.exp(co.stiffness_c2 * (1.0 - w) * f.log_c2)  # P = (c²)^(s_c (1 − w))
-    Ci = c / (2.0 * f.a[:, None] * (1.0 + size) * pile_up[:, None])
-    C = Ci.sum(axis=1)
     y_bar = (c * f.y).sum(axis=1) / c.sum(axis=1)
     z_bar = (c * f.z).sum(axis=1) / c.sum(axis=1)
+    q = (co.stiffness_c2 * (1.0 - w) + co.stiffness_c2_counter * f.U + co.stiffness_c2_depth * z_bar
+         + co.stiffness_c2_c2 * f.log_c2)
+    pile_up = np.exp(q * f.log_c2)  # P = (c²)^q
+    Ci = c / (2.0 * f.a[:, None] * (1.0 + size) * pile_up[:, None])
+    C = Ci.sum(axis=1)
     m_flat = co.m_plastic + co.m_c2 * f.log_c2 + co.m_depth * z_bar + co.m_lambda * f.lam
     m_p = (1.0 - f.U) * m_flat + f.U * co.m_counter
     m = np.clip((1.0 - w) * m_p + w * (1.5 + co.m_elastic_size * y_bar**2), *EXPONENT_RANGE)

@@ -92,6 +92,22 @@ def test_pile_up_stiffens_a_plastic_peak():
     assert np.all(d1 < d0)
 
 
+def test_pile_up_exponent_terms():
+    """P = (c²)^q, q = s_c (1 − w) + s_U U + s_z z̄ + s_2 ln c²: the three terms divide δ_e by
+    exp((s_U U + s_z z̄ + s_2 ln c²) ln c²) and leave m alone; on a flat (U = 0) s_U does nothing."""
+    f = _peaks()
+    z_bar = f.z[:, 0]  # one deformable body
+    m0, d0, *_ = unloading_law(f, BASE)
+    m1, d1, *_ = unloading_law(f, replace(BASE, stiffness_c2_counter=-0.3, stiffness_c2_depth=-0.1,
+                                          stiffness_c2_c2=-0.2))
+    q = -0.3 * f.U - 0.1 * z_bar - 0.2 * f.log_c2
+    np.testing.assert_allclose(m1, m0)
+    np.testing.assert_allclose(d1 / d0, np.exp(-q * f.log_c2), rtol=1e-12)
+    _, d2, *_ = unloading_law(f, replace(BASE, stiffness_c2_counter=-0.3))
+    np.testing.assert_allclose(d2[0], d0[0], rtol=1e-14)
+    assert d2[1] > d0[1]  # less pile-up stiffening under the curved counter-surface
+
+
 def test_plastic_exponent_grows_with_lambda():
     """m = (1 − w)[(1 − U)(… + m_λ λ) + U m_counter] + w (…): the term is m_λ λ (1 − w)(1 − U)."""
     f = _peaks()
@@ -279,11 +295,12 @@ def test_unloading_section_round_trip_and_errors(co):
 def test_an_older_unloading_section_gives_the_law_without_the_new_terms(co):
     """Files written before size_counter, stiffness_c2 and m_lambda leave them out: 0."""
     d = co.to_dict()
-    new = dict(d["unloading"], size_counter=0.5, stiffness_c2=0.1, m_lambda=0.2)
+    new = dict(d["unloading"], size_counter=0.5, stiffness_c2=0.1, m_lambda=0.2, stiffness_c2_counter=-0.3,
+               stiffness_c2_depth=-0.1, stiffness_c2_c2=-0.2)
     older = {k: v for k, v in new.items() if k not in UNLOADING_OPTIONAL}
     law_old = Coefficients.from_dict(dict(d, unloading=older)).unloading
     assert law_old == replace(Coefficients.from_dict(dict(d, unloading=new)).unloading,
-                              size_counter=0.0, stiffness_c2=0.0, m_lambda=0.0)
+                              **dict.fromkeys(UNLOADING_OPTIONAL, 0.0))
     # the law before these terms: g_i = 1 + [g_a y² + g_h z][1 + g_ν (ν − 0.3)], m without m_λ λ
     f, u = _peaks(), law_old
     Ci = f.compliance / (2 * f.a[:, None] * (1 + (u.size_a * f.y**2 + u.size_h * f.z)
