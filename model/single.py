@@ -54,6 +54,8 @@ from .levels import (
     finite_size_by_level,
     level_weight,
     levels_scalar_n,
+    onset_Lambda_u,
+    onset_stage,
     stage,
 )
 from .material import Material
@@ -268,10 +270,14 @@ class BodyLaw:
         s, ds = level_weight(mat.E_prime * x / sig, co)
         return s, ds * (1.0 - m), self.H_bar_III * sig, m
 
-    def _piece(self, Lam, eps, y) -> np.ndarray:
-        """Smooth-piece id from the stage of Λ (``levels.stage``: the levels, and the end of the
-        unloading onset ramp in Level II), ε_rep (flow-table segment) and y (beyond x_fit_max)."""
-        piece = stage(Lam, self.coeffs) + 4 * _segment(self.material, eps, self.coeffs.strain_spread)
+    def _piece(self, Lam, eps, y, x) -> np.ndarray:
+        """Smooth-piece id from the level of Λ (``levels.stage``), the stage of the unloading
+        onset ramp (``levels.onset_stage`` of Λ_u, x = a/ρ), ε_rep (flow-table segment) and y
+        (beyond x_fit_max)."""
+        mat, co = self.material, self.coeffs
+        Lam_u = onset_Lambda_u(Lam, mat.E_prime * np.asarray(x, dtype=float) / mat.sigma_y)
+        piece = (stage(Lam, co) + 3 * onset_stage(Lam_u, co)
+                 + 9 * _segment(mat, eps, co.strain_spread))
         if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
             piece = 2 * piece + (y > self.x_fit_max)
         return piece
@@ -279,7 +285,8 @@ class BodyLaw:
     def piece_at(self, x, y=None) -> np.ndarray:
         """The smooth-piece id of :meth:`response` at x = a/ρ (finite-size ratio y, default x)
         without the rest of the response: the level of Λ = E'x/σ_rep (Λ = 0 for an elastic body),
-        the flow-table segment of ε_rep and whether y lies beyond x_fit_max."""
+        the stage of the unloading onset ramp, the flow-table segment of ε_rep and whether y lies
+        beyond x_fit_max."""
         mat, co = self.material, self.coeffs
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
@@ -288,7 +295,7 @@ class BodyLaw:
             Lam = np.zeros_like(x)
         else:
             Lam = mat.E_prime * x / representative_stress(mat, eps, co.strain_spread)[0]
-        return self._piece(Lam, eps, y)
+        return self._piece(Lam, eps, y, x)
 
     def response(self, x, y=None, z: float = 0.0, xc=None) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
@@ -323,7 +330,7 @@ class BodyLaw:
         xm = self.x_fit_max
         fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
         fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
-        piece = self._piece(Lam, eps, y)
+        piece = self._piece(Lam, eps, y, x)
         p, c = p * fH, c * fc
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc

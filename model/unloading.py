@@ -36,7 +36,7 @@ more conforming residual profile). The law here (``UnloadingCoefficients``):
 * h_res = r · max(h_max − δ_e, 0), r the onset ramp of the body further into plasticity
   (``levels.onset_ramp``: 0 in Level I, 1 once its level weight reaches ``levels.ONSET`` = 10⁻³,
   linear in ln Λ between) read at Λ_u = E'a/(ρ √(σ_Y σ_rep)), Johnson's parameter with the
-  geometric mean of the yield stress and the representative stress (:func:`onset_Lambda_u`): an
+  geometric mean of the yield stress and the representative stress (``levels.onset_Lambda_u``): an
   elastic peak leaves no residual approach. Such a peak unloads
   along the loading curve itself (no hysteresis; ``Peak.plastic`` False);
 * each body's residual approach (its share of the residual dent): h_res,i ∝ max(h_i −
@@ -54,12 +54,11 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import UnloadingCoefficients
-from .levels import onset_ramp
+from .levels import onset_Lambda_u, onset_ramp
 from .unified import UnifiedPair, UnifiedState
 
 __all__ = ["EXPONENT_RANGE", "Peak", "PeakFeatures", "features", "peak_features",
-           "unloading_law", "peak_parameters", "branch", "work_returned", "onset_Lambda_u",
-           "PILE_UP_TERMS"]
+           "unloading_law", "peak_parameters", "branch", "work_returned", "PILE_UP_TERMS"]
 
 # ``levels.ONSET``: the level weight at which the residual approach has grown from 0 (Level I)
 # to the law's value (FE cycles at weights 1e-4 / 1e-3 / 4e-3 left 0 / 4 / 3 % of h_max;
@@ -73,14 +72,6 @@ EXPONENT_RANGE = (1.0, 3.0)
 #: left them 11–14 % too stiff
 PILE_UP_TERMS = ("stiffness_c2_counter", "stiffness_c2_depth", "stiffness_c2_c2")
 
-#: q of the onset's stress σ_Y^q σ_rep^(1−q) (:func:`onset_Lambda_u`). A strongly hardening body
-#: whose σ_rep keeps up with E'a/ρ stays below Λ_I by Johnson's Λ although it has yielded: read
-#: with σ_rep (q = 0) the FE's flats K/σ_Y 10, n 0.6, E/σ_Y 10 and K 9.29, n 0.11, E/σ_Y 30.8
-#: at h/R = 0.3 left h_res/h_max = 0.135 and 0.163 where the law gave 0. Calibration
-#: branches above 3 % in F / h_res and the largest h_res error (379 branches), validation
-#: branches above 3 % in h_res (146): q = 0: 7 / 10, 16.3 %, 1; 0.35: 6 / 7, 4.2 %, 0; 0.5:
-#: 6 / 8, 4.5 %, 0; 0.6: 15 / 11, 4.5 %, 1; 1 (σ_Y alone, an onset too early): 16 / 13, 4.5 %, 3
-ONSET_YIELD_WEIGHT = 0.5
 
 
 class Peak(NamedTuple):
@@ -134,13 +125,6 @@ def features(h, F, a, h_i, compliance, nu, radius, kappa, R_star: float,
     return PeakFeatures(h=h, F=F, a=a, h_i=h_i, compliance=c, nu=nu, y=y, z=z, lam=lam, U=u / (1.0 + u),
                         log_c2=np.log(a * a / (2.0 * R_star * h)),
                         onset=np.asarray(onset, dtype=float))
-
-
-def onset_Lambda_u(Lambda, Lambda_y):
-    """Λ_u = Λ^(1−q) Λ_Y^q = E'a/(ρ σ_Y^q σ_rep^(1−q)), q = ``ONSET_YIELD_WEIGHT``, from Johnson's
-    Λ = E'a/(ρ σ_rep) and Λ_Y = E'a/(ρ σ_Y): the parameter the onset of the residual approach reads."""
-    Lam = np.maximum(np.asarray(Lambda, dtype=float), 0.0)
-    return Lam ** (1.0 - ONSET_YIELD_WEIGHT) * np.asarray(Lambda_y, dtype=float) ** ONSET_YIELD_WEIGHT
 
 
 def peak_features(p: UnifiedPair, st: UnifiedState) -> PeakFeatures:
