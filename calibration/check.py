@@ -104,8 +104,23 @@ def grid_pairs(calibration: list[Material]) -> list[tuple[str, Sphere, Sphere]]:
     return out
 
 
-def check_all(coeffs: Coefficients, calibration: list[Material]) -> list[MonotoneCheck]:
-    return [check_pair(lab, s1, s2, coeffs) for lab, s1, s2 in grid_pairs(calibration)]
+#: pairs per task when :func:`check_all` runs on worker processes
+CHUNK = 24
+
+
+def check_all(coeffs: Coefficients, calibration: list[Material], pool=None) -> list[MonotoneCheck]:
+    """:func:`check_pair` of every pair of :func:`grid_pairs`, in order; on the worker
+    processes of ``pool`` (``workers.Workers``) in chunks of ``CHUNK`` pairs when given."""
+    pairs = grid_pairs(calibration)
+    if pool is None:
+        return _check_chunk(None, coeffs, pairs)
+    chunks = [(coeffs, pairs[i:i + CHUNK]) for i in range(0, len(pairs), CHUNK)]
+    return [c for done in pool.map(_check_chunk, chunks) for c in done]
+
+
+def _check_chunk(_ds, coeffs: Coefficients, pairs) -> list[MonotoneCheck]:
+    """:func:`check_pair` of ``pairs`` (a worker task; the dataset argument is not used)."""
+    return [check_pair(lab, s1, s2, coeffs) for lab, s1, s2 in pairs]
 
 
 @dataclass

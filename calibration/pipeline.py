@@ -193,7 +193,7 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
             t_i = time.perf_counter()
             interfaces[name] = fit_interface(pairs, fits[name].coeffs, pool) if pairs else None
             interface_s += time.perf_counter() - t_i
-            checks[name] = check_all(with_interface(fits[name].coeffs, interfaces[name]), mats)
+            checks[name] = check_all(with_interface(fits[name].coeffs, interfaces[name]), mats, pool)
             checks_ok[name] = all(c.ok for c in checks[name])
         return checks_ok[name]
 

@@ -335,3 +335,20 @@ def test_regime_folds_hold_out_whole_regimes_and_predict_them():
     assert np.all(np.abs(np.delete(J, free, axis=1)).max(axis=0) > 0.01)
     with pytest.raises(ValueError, match="regime family"):
         regime_of(ds.curves[0], "colour")
+
+
+def test_monotonicity_checks_on_worker_processes_match_the_serial_ones(monkeypatch):
+    """``check_all`` with a pool: the same checks, in the same order, as in this process."""
+    from spherecontact.calibration import check
+    from spherecontact.calibration.workers import Workers
+
+    co = load_coefficients()
+    mats = [Material(E=200.0, nu=0.3, sigma_y=1.0), Material(E=1000.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)]
+    pairs = check.grid_pairs(mats)[:7]
+    monkeypatch.setattr(check, "grid_pairs", lambda calibration: pairs)
+    monkeypatch.setattr(check, "CHUNK", 3)  # three tasks, the last one short
+    serial = check.check_all(co, mats)
+    with Workers(None, 2) as pool:
+        parallel = check.check_all(co, mats, pool)
+    assert [c.label for c in serial] == [p[0] for p in pairs]
+    assert parallel == serial
