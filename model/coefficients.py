@@ -212,7 +212,10 @@ class UnloadingCoefficients:
     stiffness_c2: float = 0.0
     #: m_λ: the plastic exponent grows by m_λ λ against a flat
     m_lambda: float = 0.0
-    #: s_U, s_z, s_2 of the pile-up exponent q (curved counter-surface, depth, ln c² itself)
+    #: s_U, s_z, s_2 of the pile-up exponent q (curved counter-surface, depth, ln c² itself): the
+    #: deepest cycles of perfectly plastic spheres under rigid spheres of R_i ≈ R keep c² > 1 while
+    #: the body flattens to a/R ≈ 0.6, and s_c (1 − w) alone left them 11–14 % too stiff
+    #: (model/README.md, "Unloading and reloading")
     stiffness_c2_counter: float = 0.0
     stiffness_c2_depth: float = 0.0
     stiffness_c2_c2: float = 0.0

@@ -275,12 +275,17 @@ class BodyLaw:
         onset ramp (``levels.onset_stage`` of Λ_u, x = a/ρ), ε_rep (flow-table segment) and y
         (beyond x_fit_max)."""
         mat, co = self.material, self.coeffs
-        Lam_u = onset_Lambda_u(Lam, mat.E_prime * np.asarray(x, dtype=float) / mat.sigma_y)
-        piece = (stage(Lam, co) + 3 * onset_stage(Lam_u, co)
+        piece = (stage(Lam, co) + 3 * onset_stage(self.onset_Lambda(x, Lam), co)
                  + 9 * _segment(mat, eps, co.strain_spread))
         if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
             piece = 2 * piece + (y > self.x_fit_max)
         return piece
+
+    def onset_Lambda(self, x, Lam) -> np.ndarray:
+        """Λ_u at x = a/ρ from Johnson's Λ there (``levels.onset_Lambda_u``, Λ_Y = E'x/σ_Y): what
+        the unloading onset ramp reads (0 for an elastic body)."""
+        mat = self.material
+        return onset_Lambda_u(Lam, mat.E_prime * np.asarray(x, dtype=float) / mat.sigma_y)
 
     def piece_at(self, x, y=None) -> np.ndarray:
         """The smooth-piece id of :meth:`response` at x = a/ρ (finite-size ratio y, default x)

@@ -23,7 +23,7 @@ more conforming residual profile). The law here (``UnloadingCoefficients``):
   peaks, a/R* ≈ 0.9, unload up to 15 % softer than the law), P = (c²)^q with
   q = s_c (1 − w) + s_U U + s_z z̄ + s_2 ln c² (a plastic peak with pile-up, c² > 1, unloads
   stiffer than one that sinks in; less so under a curved counter-surface, when deep, or with
-  much pile-up: ``PILE_UP_TERMS``);
+  much pile-up: ``UnloadingCoefficients.stiffness_c2_counter``, ``_depth``, ``_c2``);
   δ_e = m F_max C/s₀ with C = Σ C_i;
 * m = (1 − w)[(1 − U)(m_p + m_c2 ln c² + m_depth z̄ + m_λ λ) + U m_counter] + w (3/2 + m_el ȳ²),
   clipped to [1, 3], with the elastic weight w = min(λ, 1)^k, λ = p_m/p_Hertz(a) =
@@ -54,24 +54,17 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import UnloadingCoefficients
-from .levels import onset_Lambda_u, onset_ramp
+from .levels import onset_ramp
 from .unified import UnifiedPair, UnifiedState
 
 __all__ = ["EXPONENT_RANGE", "Peak", "PeakFeatures", "features", "peak_features",
-           "unloading_law", "peak_parameters", "branch", "work_returned", "PILE_UP_TERMS"]
+           "unloading_law", "peak_parameters", "branch", "work_returned"]
 
 # ``levels.ONSET``: the level weight at which the residual approach has grown from 0 (Level I)
 # to the law's value (FE cycles at weights 1e-4 / 1e-3 / 4e-3 left 0 / 4 / 3 % of h_max;
 # ONSET = 1e-2 raised the validation branches above 3 % from 8 to 12)
 #: the unloading exponent is kept in this range (F stays increasing and C¹ at h_res)
 EXPONENT_RANGE = (1.0, 3.0)
-
-#: the pile-up exponent's terms s_U U + s_z z̄ + s_2 ln c² beside s_c (1 − w) (measured in
-#: model/README.md, "Unloading"): the deepest cycles of perfectly plastic spheres under rigid
-#: spheres of R_i ≈ R keep c² > 1 while the body flattens to a/R ≈ 0.6, and s_c (1 − w) alone
-#: left them 11–14 % too stiff
-PILE_UP_TERMS = ("stiffness_c2_counter", "stiffness_c2_depth", "stiffness_c2_c2")
-
 
 
 class Peak(NamedTuple):
@@ -130,13 +123,12 @@ def features(h, F, a, h_i, compliance, nu, radius, kappa, R_star: float,
 def peak_features(p: UnifiedPair, st: UnifiedState) -> PeakFeatures:
     """:class:`PeakFeatures` of the model's loaded states ``st`` of the pair ``p``."""
     comp, nu, radius, s_max = [], [], [], np.zeros_like(st.a)
-    for s, Lam, rho in ((p.s1, st.Lambda1, st.rho1), (p.s2, st.Lambda2, st.rho2)):
+    for s, law, Lam, rho in ((p.s1, p.law1, st.Lambda1, st.rho1), (p.s2, p.law2, st.Lambda2, st.rho2)):
         comp.append(0.0 if s.is_rigid else 1.0 / s.material.E_prime)
         nu.append(s.material.nu)
         radius.append(s.radius)
         if not s.is_rigid and math.isfinite(s.material.sigma_y):
-            Lam_u = onset_Lambda_u(Lam, s.material.E_prime * st.a / (rho * s.material.sigma_y))
-            s_max = np.maximum(s_max, onset_ramp(Lam_u, p.coeffs))
+            s_max = np.maximum(s_max, onset_ramp(law.onset_Lambda(st.a / rho, Lam), p.coeffs))
     return features(st.h, st.F, st.a, np.stack([st.h1, st.h2], axis=1), comp, nu, radius, st.kappa,
                     p.R_star, s_max)
 
