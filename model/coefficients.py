@@ -391,11 +391,20 @@ def continue_beyond(x, x_max):
     return np.minimum(x, x_max), x_max / np.maximum(x, x_max)   # u = 1.0 exactly up to x_max
 
 
+def continued_log(x, x_max):
+    """x_c, u of :func:`continue_beyond` and ln x_c (−inf at x = 0)."""
+    xc, u = continue_beyond(np.asarray(x, dtype=float), x_max)
+    with np.errstate(divide="ignore"):
+        return xc, u, np.log(xc)
+
+
 def _poly_and_slope(x, poly: tuple[float, ...]):
     """Σ_k c_k x^(k+1) and its log slope x d/dx = Σ_k (k+1) c_k x^(k+1)."""
-    s = np.zeros_like(x)
-    ds = np.zeros_like(x)
-    for k in range(len(poly) - 1, -1, -1):
+    if not poly:
+        return np.zeros_like(x), np.zeros_like(x)
+    k = len(poly) - 1
+    s, ds = poly[k] * x, ((k + 1) * poly[k]) * x  # the first Horner step from s = ds = 0
+    for k in range(len(poly) - 2, -1, -1):
         s = (s + poly[k]) * x
         ds = (ds + (k + 1) * poly[k]) * x
     return s, ds
@@ -416,6 +425,28 @@ def _z_terms(z, z_max: float | None, poly: tuple[float, ...]):
     beyond = z > z_max
     return (np.where(beyond, sz + S * (1.0 - u), sz),
             np.where(beyond, S * u / (1.0 + np.maximum(z, z_max)), dz))
+
+
+@dataclass(frozen=True)
+class CollapseLimitAt:
+    """A collapse limit at one n and one z (:meth:`CollapseLimit.at`): ln L = log_const
+    − exponent ln x + Σ x_poly[k] x^(k+1), continued beyond x_max as
+    :meth:`CollapseLimit.log_and_slope`; d ln L/d z is the constant dlnL_dz."""
+
+    log_const: float
+    exponent: float
+    x_poly: tuple[float, ...]
+    dlnL_dz: float
+
+    def log_and_slope(self, x, x_max: float | None = None, cont=None):
+        """ln L, d ln L/d ln x and d ln L/d z at x (vectorised, x > 0); ``cont``: the
+        :func:`continued_log` of (x, x_max) if at hand."""
+        xc, u, ln_xc = continued_log(x, x_max) if cont is None else cont
+        s, ds = _poly_and_slope(xc, self.x_poly)
+        if x_max is not None:
+            s, ds = s + (ds - self.exponent) * (1.0 - u), ds * u + self.exponent * (1.0 - u)
+        power = self.exponent * ln_xc if self.exponent else 0.0
+        return self.log_const - power + s, ds - self.exponent, self.dlnL_dz
 
 
 @dataclass(frozen=True)
@@ -468,6 +499,21 @@ class CollapseLimit:
 
     def __call__(self, x, n=0.0, z=0.0):
         return np.exp(self.log_and_slope(x, n, z)[0])
+
+    @lru_cache(maxsize=64)  # noqa: B019 -- frozen and hashable; a body law asks for one (n, z)
+    def at(self, n: float, z: float, z_max: float | None = None) -> CollapseLimitAt:
+        """The limit at one hardening exponent n and one z (floats): the n- and z-terms of
+        :meth:`log_and_slope` summed once, for a body law that reads them at every x."""
+        sz, dz = _z_terms(z, z_max, self.z_poly)
+        if self.zn_poly:
+            szn, dzn = _z_terms(z, z_max, self.zn_poly)
+            sz, dz = sz + n * szn, dz + n * dzn
+        k = max(len(self.x_poly), len(self.xn_poly))
+        x_poly = tuple(c + n * d for c, d in zip(self.x_poly + (0.0,) * (k - len(self.x_poly)),
+                                                 self.xn_poly + (0.0,) * (k - len(self.xn_poly)),
+                                                 strict=True))
+        const = math.log(self.prefactor) + float(sz) + math.log(float(_exp_poly(1.0, self.exp_poly, n)))
+        return CollapseLimitAt(log_const=const, exponent=self.exponent, x_poly=x_poly, dlnL_dz=float(dz))
 
     def to_dict(self) -> dict:
         return {"prefactor": self.prefactor, "exponent": self.exponent,

@@ -291,19 +291,23 @@ class ContactLaw:
 
     def _find_kinks(self, grid: np.ndarray, st: UnifiedState) -> np.ndarray:
         """ln(a/R*) of every piece change of the pair between grid nodes inside the table
-        (``self._lnX``), by multi-section (:meth:`_first_changes`). A grid interval can hold
-        more than one change (a flow table's nodes crossed by the representative stress's three
-        strains come closer than the grid step at large a): while the piece just above the change
-        found differs from the piece at the interval's upper node, the rest of the interval is
-        searched again."""
+        (``self._lnX``), by multi-section: the first pass splits each grid interval at every
+        change between its sections (:meth:`_split_changes`), the next passes narrow each part
+        to its first change (:meth:`_first_changes`). A part can still hold more than one
+        change (two within one section of the first pass): while the piece just above the
+        change found differs from the piece at the part's upper end, the rest of it is searched
+        again. With the first change per grid interval alone, the second of two changes in one
+        interval (a Λ level and the end of the onset ramp, or a flow table's nodes crossed by
+        the representative stress's three strains) took a whole second search."""
         lo_end, hi_end = self._lnX
         piece = st.piece
         j = np.nonzero((piece[1:] != piece[:-1]) & (grid[1:] > lo_end) & (grid[:-1] < hi_end))[0]
         if j.size == 0:
             return np.empty(0)
-        lo, hi, p_lo, p_hi = grid[j], grid[j + 1], piece[j], piece[j + 1]
         u = self._u_of(st)
-        u_lo, u_hi = (None, None) if u is None else (u[j], u[j + 1])
+        lo, hi, p_lo, p_hi, u_lo, u_hi = self._split_changes(
+            grid[j], grid[j + 1], piece[j], piece[j + 1],
+            None if u is None else u[j], None if u is None else u[j + 1])
         found = []
         for _ in range(_KINKS_PER_STEP):
             kink, p_kink, u_kink = self._first_changes(lo, hi, p_lo, u_lo, u_hi)
@@ -317,26 +321,36 @@ class ContactLaw:
         kinks = np.sort(np.concatenate(found))
         return kinks[(kinks > lo_end) & (kinks < hi_end)]
 
+    def _split_changes(self, lo, hi, p_lo, p_hi, u_lo, u_hi):
+        """The first pass of the kink search: the pieces at the sections of every bracket
+        [lo, hi] (one vectorised κ solve warm-started by the grid's Hermite of u) and, for
+        every change between consecutive points (the ends included), the section that holds
+        it: its ends, their pieces and their u (None for scenes without a κ solve)."""
+        n = _sections(float(np.max(hi - lo)), lo.size)
+        pts = lo[:, None] + (hi - lo)[:, None] * (np.arange(1, n) / n)[None, :]
+        pieces, up = self._pieces(pts.ravel(), None if u_lo is None else self._u_at(pts.ravel()))
+        X = np.concatenate([lo[:, None], pts, hi[:, None]], axis=1)
+        P = np.concatenate([p_lo[:, None], pieces.reshape(pts.shape), p_hi[:, None]], axis=1)
+        r, k = np.nonzero(P[:, 1:] != P[:, :-1])  # row by row, left to right
+        if u_lo is None:
+            return X[r, k], X[r, k + 1], P[r, k], P[r, k + 1], None, None
+        U = np.concatenate([u_lo[:, None], up.reshape(pts.shape), u_hi[:, None]], axis=1)
+        return X[r, k], X[r, k + 1], P[r, k], P[r, k + 1], U[r, k], U[r, k + 1]
+
     def _first_changes(self, lo, hi, p_lo, u_lo, u_hi):
         """The first piece change above ``lo`` in each bracket [lo, hi] whose lower end has the
         piece ``p_lo``, to ``_KINK_TOL``: one vectorised κ solve per pass (and the pieces,
         :meth:`_pieces`), warm-started by u interpolated between the ends of each bracket
-        (u = ln(ρ_2/ρ_1) of the last pass; the grid's Hermite in the first). Returns the point
+        (u = ln(ρ_2/ρ_1) of the pass before; the brackets are sections of the first pass,
+        :meth:`_split_changes`, where this guess is closer than the grid's Hermite). Returns the point
         just above each change, its piece and u there (None for scenes without a κ solve)."""
         p_lo = p_lo[:, None]
         n = _sections(float(np.max(hi - lo)), lo.size)
         frac = np.arange(1, n) / n
         rows = np.arange(lo.size)
-        first_pass = True
         while np.max(hi - lo) > _KINK_TOL:
             pts = lo[:, None] + (hi - lo)[:, None] * frac[None, :]
-            if u_lo is None:
-                guess = None
-            elif first_pass:
-                guess = self._u_at(pts.ravel())
-            else:
-                guess = (u_lo[:, None] + (u_hi - u_lo)[:, None] * frac[None, :]).ravel()
-            first_pass = False
+            guess = None if u_lo is None else (u_lo[:, None] + (u_hi - u_lo)[:, None] * frac[None, :]).ravel()
             pieces, up = self._pieces(pts.ravel(), guess)
             changed = pieces.reshape(pts.shape) != p_lo
             first = np.where(changed.any(axis=1), np.argmax(changed, axis=1), frac.size)

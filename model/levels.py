@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .coefficients import Coefficients, continue_beyond
+from .coefficients import Coefficients, continue_beyond, continued_log
 
 __all__ = [
     "C2_HERTZ",
@@ -55,8 +55,10 @@ __all__ = [
     "stage",
     "finite_size_by_level",
     "collapse_blend",
+    "collapse_pressure",
     "CollapseBlend",
     "levels_scalar_n",
+    "level_t",
 ]
 
 #: Hertz contact-area parameter c² = a²/(2hR) = 1/2 (a² = R h).
@@ -72,9 +74,9 @@ def level(Lambda, coeffs: Coefficients) -> np.ndarray:
 
 def _poly_and_derivative(t, b: tuple[float, ...]):
     """P(t) = Σ b_k t^k and P'(t)."""
-    P = np.zeros_like(t)
+    P = np.full_like(t, b[-1])  # the first Horner step from P = dP = 0
     dP = np.zeros_like(t)
-    for c in reversed(b):
+    for c in reversed(b[:-1]):
         dP = dP * t + P
         P = P * t + c
     return P, dP
@@ -115,29 +117,70 @@ def _level_II(Lambda, q_I, q_III, coeffs: Coefficients, shape, m0=0.0, shape_n=(
     return q_I + (q_III - q_I) * s, (q_III - q_I) * ds / L
 
 
-def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_III: float, n: float = 0.0):
+def _with_n(b: tuple[float, ...], bn: tuple[float, ...], n: float) -> tuple[float, ...]:
+    """The shape coefficients b_k + bn_k n at one hardening exponent n (``_shape``)."""
+    if not bn:
+        return tuple(b)
+    m = max(len(b), len(bn))
+    b, bn = tuple(b) + (0.0,) * (m - len(b)), tuple(bn) + (0.0,) * (m - len(bn))
+    return tuple(c + n * d for c, d in zip(b, bn, strict=True))
+
+
+def level_t(Lambda, coeffs: Coefficients) -> np.ndarray:
+    """t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) clipped to [0, 1]: the Level II coordinate (0 in Level I,
+    1 in Level III) that the shapes and the level weight read."""
+    L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
+    with np.errstate(divide="ignore"):
+        return np.clip(np.log(np.asarray(Lambda, dtype=float) / coeffs.Lambda_I) / L, 0.0, 1.0)
+
+
+def _smooth_shapes(t, shapes):
+    """:func:`_shape` (smooth) of several (b, m₀) at the same t, the powers of t shared."""
+    u = 1.0 - t
+    tt, tu = t * t, t * u
+    ttuu = tt * u * u
+    s0, ds0 = tt * (3.0 - 2.0 * t), 6.0 * tu
+    m0_s, m0_ds, P_ds = t * u * u, u * (1.0 - 3.0 * t), 2.0 * tu * (1.0 - 2.0 * t)
+    out = []
+    for b, m0 in shapes:
+        P, dP = _poly_and_derivative(t, b) if b else (0.0, 0.0)
+        out.append((s0 + m0 * m0_s + ttuu * P, ds0 + m0 * m0_ds + P_ds * P + ttuu * dP))
+    return out
+
+
+def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_III: float, n: float = 0.0,
+                    t=None, with_c2: bool = True):
     """H̄, d ln H̄/d ln Λ, c², d ln c²/d ln Λ and the level index in one pass.
 
-    Fast path for one material (Level III values H_III, c2_III given as floats);
-    same results as :func:`H_bar_and_slope` and :func:`c2_and_slope`.
+    Fast path for one material (Level III values H_III, c2_III given as floats; ``t`` of
+    :func:`level_t` if at hand); the same results as :func:`H_bar_and_slope` and
+    :func:`c2_and_slope` to rounding. ``with_c2`` False: H̄ alone (c² and its slope None).
     """
     Lam = np.asarray(Lambda, dtype=float)
     lam1, lam3 = coeffs.Lambda_I, coeffs.Lambda_III
     L = math.log(lam3 / lam1)
     lev = np.where(Lam <= lam1, 1, np.where(Lam < lam3, 2, 3))
-    with np.errstate(divide="ignore"):
-        t = np.clip(np.log(Lam / lam1) / L, 0.0, 1.0)
+    if t is None:
+        t = level_t(Lam, coeffs)
     H_I = coeffs.H_bar_I
-    sm = coeffs.level_II_smooth
-    sH_t, dsH_t = _shape(t, coeffs.H_bar_shape, sm, _m0_H(coeffs, H_III) if sm else 0.0,
-                         coeffs.H_bar_shape_n, n)
-    sc_t, dsc_t = _shape(t, coeffs.c2_shape, sm, 0.0, coeffs.c2_shape_n, n)
+    m0 = _m0_H(coeffs, H_III) if coeffs.level_II_smooth else 0.0
+    shapes = [(_with_n(coeffs.H_bar_shape, coeffs.H_bar_shape_n, n), m0)]
+    if with_c2:
+        shapes.append((_with_n(coeffs.c2_shape, coeffs.c2_shape_n, n), 0.0))
+    if coeffs.level_II_smooth:
+        shapes = _smooth_shapes(t, shapes)
+    else:
+        shapes = [_shape(t, b) for b, _ in shapes]
+    sH_t, dsH_t = shapes[0]
     H2 = H_I + (H_III - H_I) * sH_t
-    c2_2 = C2_HERTZ + (c2_III - C2_HERTZ) * sc_t
     one, two = lev == 1, lev == 2
     H = np.where(one, _HERTZ * Lam, np.where(two, H2, H_III))
-    c = np.where(one, C2_HERTZ, np.where(two, c2_2, c2_III))
     sH = np.where(one, 1.0, np.where(two, (H_III - H_I) * dsH_t / (L * H2), 0.0))
+    if not with_c2:
+        return H, sH, None, None, lev
+    sc_t, dsc_t = shapes[1]
+    c2_2 = C2_HERTZ + (c2_III - C2_HERTZ) * sc_t
+    c = np.where(one, C2_HERTZ, np.where(two, c2_2, c2_III))
     sc = np.where(two, (c2_III - C2_HERTZ) * dsc_t / (L * c2_2), 0.0)
     return H, sH, c, sc, lev
 
@@ -180,15 +223,21 @@ def finite_size_factor(x, poly: tuple[float, ...], x_max: float | None = None):
     x = np.asarray(x, dtype=float)
     if not poly:
         return np.ones_like(x), np.zeros_like(x)
-    xc, u = continue_beyond(x, x_max)  # (x, 1) for x_max None
-    s = np.zeros_like(xc)   # Σ c_k x^(k+1)
-    ds = np.zeros_like(xc)  # Σ (k+1) c_k x^(k+1)
-    for k in range(len(poly) - 1, -1, -1):
+    return _factor_continued(*continue_beyond(x, x_max), poly, x_max is not None)
+
+
+def _factor_continued(xc, u, poly: tuple[float, ...], continued: bool):
+    """:func:`finite_size_factor` from x_c and u of ``continue_beyond`` (shared by the factors
+    of one x; ``poly`` not empty)."""
+    k = len(poly) - 1
+    s = poly[k] * xc            # Σ c_k x^(k+1), Horner from the top
+    ds = ((k + 1) * poly[k]) * xc  # Σ (k+1) c_k x^(k+1)
+    for k in range(len(poly) - 2, -1, -1):
         s = (s + poly[k]) * xc
         ds = (ds + (k + 1) * poly[k]) * xc
     f = 1.0 + s
     slope = ds / f
-    if x_max is None:
+    if not continued:
         return f, slope
     return f * np.exp(slope * (1.0 - u)), slope * u
 
@@ -225,15 +274,26 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     d ln c² = (1 − w_c) d ln c²_hs + w_c d ln c²_c + (ln c²_c − ln c²_hs) dw_c,
     dw_c = k_c w_c (1 − w_c) (d ln H̄_hs − d ln H̄_c).
     """
-    H_hs, c2_hs, x, n, z = np.broadcast_arrays(
-        *(np.asarray(v, dtype=float) for v in (H_hs, c2_hs, x, n, z)))
+    fixed = np.ndim(n) == 0 and np.ndim(z) == 0  # one body law: its n and z are numbers
+    if fixed:
+        n, z = float(n), float(z)
+        H_hs, c2_hs, x = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (H_hs, c2_hs, x)))
+    else:
+        H_hs, c2_hs, x, n, z = np.broadcast_arrays(
+            *(np.asarray(v, dtype=float) for v in (H_hs, c2_hs, x, n, z)))
     zero = np.zeros_like(H_hs)
     if not coeffs.has_collapse:
         return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero, zero, zero, zero)
     xm, zm = coeffs.x_fit_max, coeffs.collapse_z(coeffs.z_fit_max)
     zv = coeffs.collapse_z(z)  # the z-polynomials' variable (``collapse.z_variable``)
-    lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, zv, xm, zm)
-    lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, zv, xm, zm)
+    if fixed:  # the n- and z-terms summed once per body law (``CollapseLimit.at``)
+        zv, zm = float(zv), float(zm)
+        cont = continued_log(x, xm)  # shared by both limits
+        lnHc, sHc, zHc = coeffs.collapse_H_bar.at(n, zv, zm).log_and_slope(x, xm, cont)
+        lncc, scc, zcc = coeffs.collapse_c2.at(n, zv, zm).log_and_slope(x, xm, cont)
+    else:
+        lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, zv, xm, zm)
+        lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, zv, xm, zm)
     if coeffs.collapse_z_variable != "z":  # d/dz = d/dζ · dζ/dz
         dzeta = coeffs.collapse_z_slope(z)
         zHc, zcc = zHc * dzeta, zcc * dzeta
@@ -244,8 +304,8 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
 
 def _weight(z):
     """w = e^z/(1 + e^z) and ln(1 + e^z), without overflow."""
-    w = np.where(z > 0.0, 1.0 / (1.0 + np.exp(-z)), np.exp(z) / (1.0 + np.exp(z)))
-    return w, np.where(z > 0.0, z + np.log1p(np.exp(-z)), np.log1p(np.exp(z)))
+    e = np.exp(-np.abs(z))  # e^(−z) for z > 0, e^z otherwise
+    return np.where(z > 0.0, 1.0 / (1.0 + e), e / (1.0 + e)), np.maximum(z, 0.0) + np.log1p(e)
 
 
 def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
@@ -254,16 +314,32 @@ def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
     sharpnesses k (H̄) and k_c (c²; None: k) and the offset s_c of the c² weight (None: 0):
     returns H̄, c², the weight w = r^k/(1 + r^k) (r = H_hs/H̄_c), ln c²_c − ln c²_hs (0 where
     w = w_c = 0) and w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c))."""
+    H, w, lnr = _blend_H(H_hs, lnHc, k)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
-        w, log1p = _weight(k * lnr)
         if (k_c is None or k_c == k) and not s_c:
             wc = w
         else:
             wc = _weight((k if k_c is None else k_c) * (lnr + (s_c or 0.0)))[0]
-        H = np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs)
         gap = np.where((w > 0.0) | (wc > 0.0), lncc - np.log(c2_hs), 0.0)
         return H, c2_hs * np.exp(wc * gap), w, gap, wc
+
+
+def _blend_H(H_hs, lnHc, k: float):
+    """The H̄ half of :func:`blend_from_logs`: H̄, w and ln r = ln H_hs − ln H̄_c."""
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
+        w, log1p = _weight(k * lnr)
+        return np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs), w, lnr
+
+
+def collapse_pressure(H_hs, x, coeffs: Coefficients, n: float, z: float):
+    """The H̄ half of :func:`collapse_blend` for one body law (n, z numbers; ``coeffs`` with a
+    collapse block): the blended H̄, the weight w and d ln H̄_c/d ln x."""
+    zm = float(coeffs.collapse_z(coeffs.z_fit_max))
+    at = coeffs.collapse_H_bar.at(float(n), float(coeffs.collapse_z(z)), zm)
+    lnHc, sHc, _ = at.log_and_slope(x, coeffs.x_fit_max)
+    H, w, _ = _blend_H(np.asarray(H_hs, dtype=float), lnHc, coeffs.collapse_sharpness)
+    return H, w, sHc
 
 
 def counter_surface(x, y):
@@ -345,12 +421,12 @@ def stage(Lambda, coeffs: Coefficients) -> np.ndarray:
     return level(np.asarray(Lambda, dtype=float), coeffs) - 1
 
 
-def level_weight(Lambda, coeffs: Coefficients):
-    """Level weight s = 3t² − 2t³ (0 in Level I, 1 in Level III) and ds/d ln Λ."""
-    Lam = np.asarray(Lambda, dtype=float)
+def level_weight(Lambda, coeffs: Coefficients, t=None):
+    """Level weight s = 3t² − 2t³ (0 in Level I, 1 in Level III) and ds/d ln Λ (``t`` of
+    :func:`level_t` if at hand)."""
     L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
-    with np.errstate(divide="ignore"):
-        t = np.clip(np.log(Lam / coeffs.Lambda_I) / L, 0.0, 1.0)
+    if t is None:
+        t = level_t(Lambda, coeffs)
     return t * t * (3.0 - 2.0 * t), 6.0 * t * (1.0 - t) / L
 
 
@@ -372,8 +448,13 @@ def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[fl
     if elastic == plastic:
         f, dx = finite_size_factor(x, elastic, x_max)
         return f, dx, np.zeros_like(f)
-    fe, de = finite_size_factor(x, elastic, x_max)
-    fp, dp = finite_size_factor(x, plastic, x_max)
+    if elastic and plastic:  # one continuation for both
+        xc, u = continue_beyond(x, x_max)
+        fe, de = _factor_continued(xc, u, elastic, x_max is not None)
+        fp, dp = _factor_continued(xc, u, plastic, x_max is not None)
+    else:
+        fe, de = finite_size_factor(x, elastic, x_max)
+        fp, dp = finite_size_factor(x, plastic, x_max)
     f = (1.0 - s) * fe + s * fp
     return f, ((1.0 - s) * fe * de + s * fp * dp) / f, (fp - fe) * ds / f
 

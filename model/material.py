@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -143,13 +144,17 @@ class Material:
         return self.E / (3.0 * (1.0 - 2.0 * self.nu))
 
     # ------------------------------------------------------------------ flow curve
+    @cached_property
+    def _table(self):
+        """(ε, σ, segment slopes, last slope) of a tabulated flow curve as arrays (made once)."""
+        et, st = np.asarray(self.eps_table), np.asarray(self.sigma_table)
+        return et, st, np.diff(st) / np.diff(et), (st[-1] - st[-2]) / (et[-1] - et[-2])
+
     def flow_stress(self, eps_p):
         """Uniaxial flow stress σ_f(ε_p), vectorised; ε_p < 0 is treated as 0."""
         e = np.maximum(np.asarray(eps_p, dtype=float), 0.0)
         if self.eps_table is not None:
-            et = np.asarray(self.eps_table)
-            st = np.asarray(self.sigma_table)
-            slope_end = (st[-1] - st[-2]) / (et[-1] - et[-2])
+            et, st, _, slope_end = self._table
             return np.where(e <= et[-1], np.interp(e, et, st), st[-1] + slope_end * (e - et[-1]))
         if self.K == 0.0:
             return np.full_like(e, self.sigma_y)
@@ -159,9 +164,7 @@ class Material:
         """Hardening slope dσ_f/dε_p, vectorised (right derivative on tables)."""
         e = np.maximum(np.asarray(eps_p, dtype=float), 0.0)
         if self.eps_table is not None:
-            et = np.asarray(self.eps_table)
-            st = np.asarray(self.sigma_table)
-            slopes = np.diff(st) / np.diff(et)
+            et, _, slopes, _ = self._table
             idx = np.clip(np.searchsorted(et, e, side="right") - 1, 0, slopes.size - 1)
             return slopes[idx]
         if self.K == 0.0 or self.n == 0.0:

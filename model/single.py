@@ -50,8 +50,10 @@ import numpy as np
 from .coefficients import Coefficients, default_coefficients
 from .levels import (
     collapse_blend,
+    collapse_pressure,
     counter_surface,
     finite_size_by_level,
+    level_t,
     level_weight,
     levels_scalar_n,
     onset_Lambda_u,
@@ -145,10 +147,11 @@ def representative_stress(material: Material, eps, spread: float = 0.0):
     sig = np.zeros_like(e)
     dsig = np.zeros_like(e)  # Σ w_j ε_j σ_f'(ε_j) = ε dσ_rep/dε
     for f, w in spread_factors(spread):
-        s = material.flow_stress(f * e)
+        ef = f * e
+        s = material.flow_stress(ef)
         sig = sig + w * s
-        if not elastic:
-            dsig = dsig + w * flow_log_slope(material, f * e) * s
+        if not elastic:  # flow_log_slope(material, ef), its σ_f(ε_f) not evaluated twice
+            dsig = dsig + w * (ef * material.flow_slope(ef) / s) * s
     with np.errstate(invalid="ignore", divide="ignore"):
         m = np.zeros_like(e) if elastic else np.where(sig > 0.0, dsig / sig, 0.0)
     return sig, m
@@ -302,7 +305,8 @@ class BodyLaw:
             Lam = mat.E_prime * x / representative_stress(mat, eps, co.strain_spread)[0]
         return self._piece(Lam, eps, y, x)
 
-    def response(self, x, y=None, z: float = 0.0, xc=None) -> BodyResponse:
+    def response(self, x, y=None, z: float = 0.0, xc=None,
+                 pressure_only: bool = False) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
         ``z`` the curvature ratio of the collapse limits (a constant of the pair,
         :func:`curvature_ratio`); ``xc`` the contact radius over the body's Hertz relative
@@ -314,7 +318,8 @@ class BodyLaw:
         With the c² term alone on u = x − y the pair grid's monotonicity check fails. The level
         weight that moves the terms' coefficients (``counter_by_level``) is read at xc as well, for
         the same reason: read at x it left 27 of 300 random plastic pairs without a consistent root
-        from h/R ≈ 0.32 on."""
+        from h/R ≈ 0.32 on. ``pressure_only``: p_m and its slopes alone (what the κ solve reads;
+        c², its slopes and the piece are None), without the c² terms' cost."""
         mat, co = self.material, self.coeffs
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
@@ -328,17 +333,22 @@ class BodyLaw:
             sig, m = representative_stress(mat, eps, co.strain_spread)
             Lam = Ep * x / sig
             m = m * g  # d ln σ_rep/d ln x
-        H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III, self.n_eff)
+        with_c2 = not pressure_only
+        t = level_t(Lam, co)
+        H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III, self.n_eff, t, with_c2)
         with np.errstate(invalid="ignore"):
             p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
-        s_l, ds_l = level_weight(Lam, co)
+        s_l, ds_l = level_weight(Lam, co, t)
         xm = self.x_fit_max
         fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
-        fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
-        piece = self._piece(Lam, eps, y, x)
-        p, c = p * fH, c * fc
+        p = p * fH
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
-        dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
+        piece = dc_x = dc_y = None
+        if with_c2:
+            fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
+            piece = self._piece(Lam, eps, y, x)
+            c = c * fc
+            dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
         if co.has_counter_surface:  # exp(q s(u)), u = x − y (``levels.counter_surface``)
             if xc is None:
                 su, su_x, su_y = counter_surface(x, y)
@@ -349,10 +359,18 @@ class BodyLaw:
                 s_c, ds_c = self.plastic_state_at(np.asarray(xc, dtype=float))[:2]
                 lev_x, lev_y = 0.0, ds_c
             (qH, dqH), (qc, dqc) = co.counter_by_level(s_c)  # q(s), dq/ds
-            p, c = p * np.exp(qH * su), c * np.exp(qc * su)
+            p = p * np.exp(qH * su)
             dp_x, dp_y = dp_x + qH * su_x + dqH * su * lev_x, dp_y + qH * su_y + dqH * su * lev_y
-            dc_x, dc_y = dc_x + qc * su_x + dqc * su * lev_x, dc_y + qc * su_y + dqc * su * lev_y
+            if with_c2:
+                c = c * np.exp(qc * su)
+                dc_x, dc_y = dc_x + qc * su_x + dqc * su * lev_x, dc_y + qc * su_y + dqc * su * lev_y
         if co.has_collapse and not math.isinf(mat.sigma_y):
+            if not with_c2:
+                Hb, w, dlnHc = collapse_pressure(p / sig, y, co, self.n_eff, z)
+                return BodyResponse(p_m=Hb * sig, c2=None, Lambda=Lam, sigma_rep=sig,
+                                    dlnp_dlnx=(1.0 - w) * dp_x + w * m,
+                                    dlnp_dlny=(1.0 - w) * dp_y + w * dlnHc,
+                                    dlnc2_dlnx=None, dlnc2_dlny=None, piece=None)
             b = collapse_blend(p / sig, c, y, co, self.n_eff, z)
             w, wc = b.w, b.w_c2
             v = co.c2_sharpness * wc * (1.0 - wc) * b.lnc2_gap

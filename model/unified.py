@@ -211,17 +211,18 @@ class UnifiedPair:
             self._z[id(law)] = curvature_ratio(s_.radius, 1.0 / self._inv_rho_c[id(law)])
 
     # ------------------------------------------------------------------ body responses
-    def _body(self, law: BodyLaw, a, k, R) -> BodyResponse:
+    def _body(self, law: BodyLaw, a, k, R, pressure_only: bool = False) -> BodyResponse:
         x = a * k
         y = x if self._ratio_rho else a / R
-        return law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)])
+        return law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only)
 
     def _g(self, a, u, C=0.0, uA=0.0):
         """g = ln p_1 − ln p_2 + C (u − u_A) at (a, u), its u-derivative, and both responses
-        (C, u_A: :meth:`_coupling` at a, constants of the κ solve)."""
+        (C, u_A: :meth:`_coupling` at a, constants of the κ solve; the pressures alone,
+        ``BodyLaw.response`` with ``pressure_only``)."""
         w1, w2 = _sigmoid(u)
-        r1 = self._body(self.law1, a, w1 / self.R_star, self.s1.radius)
-        r2 = self._body(self.law2, a, w2 / self.R_star, self.s2.radius)
+        r1 = self._body(self.law1, a, w1 / self.R_star, self.s1.radius, True)
+        r2 = self._body(self.law2, a, w2 / self.R_star, self.s2.radius, True)
         A1 = r1.dlnp_dlnx + (r1.dlnp_dlny if self._ratio_rho else 0.0)
         A2 = r2.dlnp_dlnx + (r2.dlnp_dlny if self._ratio_rho else 0.0)
         g = np.log(r1.p_m) - np.log(r2.p_m) + C * (u - uA)
