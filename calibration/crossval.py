@@ -27,8 +27,9 @@ from .fit import FitResult, errors, fit, rms
 from .forms import Form, predict
 from .workers import Workers
 
-__all__ = ["FOLD_NFEV", "Fold", "CVResult", "fold_fit", "cross_validate", "cross_validate_many",
-           "REGIMES", "regime_of", "RegimeFold", "regime_fold_fit", "cross_validate_regimes"]
+__all__ = ["FOLD_NFEV", "Fold", "CVResult", "fold_fit", "fold_tasks", "cross_validate",
+           "cross_validate_many", "REGIMES", "regime_of", "RegimeFold", "regime_fold_fit",
+           "regime_tasks", "cross_validate_regimes"]
 
 #: iteration cap of a fold fit (warm-started from the full fit)
 FOLD_NFEV = 30
@@ -91,13 +92,18 @@ def cross_validate(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV,
 def cross_validate_many(ds: Dataset, fulls: list[FitResult], nfev: int = FOLD_NFEV,
                         workers: Workers | None = None) -> list[CVResult]:
     """:func:`cross_validate` of several fits, all their folds as one batch of tasks."""
+    tasks = [t for f in fulls for t in fold_tasks(ds, f, nfev)]
+    folds = workers.run(tasks) if workers is not None else [fn(ds, *args) for fn, args in tasks]
+    n = len(ds.groups)
+    return [CVResult(form=f.form.name, folds=folds[i * n:(i + 1) * n]) for i, f in enumerate(fulls)]
+
+
+def fold_tasks(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV) -> list[tuple]:
+    """The folds of ``full`` as ``(fold_fit, args)`` tasks (``Workers.run``), one per material."""
     groups = ds.groups
     if len(groups) < 2:
         raise ValueError("cross-validation needs at least two materials")
-    tasks = [(f.form, f.params, f.coeff_dict, g, nfev) for f in fulls for g in groups]
-    folds = workers.map(fold_fit, tasks) if workers is not None else [fold_fit(ds, *t) for t in tasks]
-    n = len(groups)
-    return [CVResult(form=f.form.name, folds=folds[i * n:(i + 1) * n]) for i, f in enumerate(fulls)]
+    return [(fold_fit, (full.form, full.params, full.coeff_dict, g, nfev)) for g in groups]
 
 
 # ------------------------------------------------------------------ held-out regimes
@@ -152,12 +158,18 @@ def cross_validate_regimes(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV,
     """Hold out one regime at a time (every label of every family of ``REGIMES`` that leaves
     runs to fit), refit ``full.form`` and predict the held-out runs: how the form extrapolates
     to a decade of E/σY, a hardening band or a partner it was not fitted on."""
+    tasks = regime_tasks(ds, full, nfev)
+    if workers is not None:
+        return workers.run(tasks)
+    return [fn(ds, *args) for fn, args in tasks]
+
+
+def regime_tasks(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV) -> list[tuple]:
+    """The regime folds of :func:`cross_validate_regimes` as ``(regime_fold_fit, args)`` tasks."""
     tasks = []
     for family in REGIMES:
         labels = sorted({regime_of(c, family) for c in ds.curves})
         if len(labels) < 2:
             continue
-        tasks += [(full.form, full.params, family, lab, nfev) for lab in labels]
-    if workers is not None:
-        return workers.map(regime_fold_fit, tasks)
-    return [regime_fold_fit(ds, *t) for t in tasks]
+        tasks += [(regime_fold_fit, (full.form, full.params, family, lab, nfev)) for lab in labels]
+    return tasks

@@ -214,15 +214,30 @@ class Dataset:
         return g[self.run]
 
     def subset(self, keep_runs: Sequence[int]) -> Dataset:
-        """A dataset of the runs ``keep_runs`` (indices into ``curves``)."""
-        return dataclasses.replace(build_dataset_from_curves([self.curves[i] for i in keep_runs]),
-                                   elastic_sphere=self.elastic_sphere)
+        """A dataset of the runs ``keep_runs`` (indices into ``curves``): the points of those
+        runs taken from this one's arrays (the same numbers as building it from the curves)."""
+        keep = list(keep_runs)
+        if not keep:
+            raise ValueError("no calibration points: no run has a resolved contact radius")
+        starts = self.cache.get("run_starts")
+        if starts is None:  # points of run i: starts[i]:starts[i + 1] (runs are contiguous)
+            starts = self.cache["run_starts"] = np.searchsorted(self.run, np.arange(len(self.curves) + 1))
+        idx = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in keep])
+        run = np.concatenate([np.full(starts[i + 1] - starts[i], j) for j, i in enumerate(keep)])
+        return Dataset(curves=tuple(self.curves[i] for i in keep), run=run,
+                       **{f: getattr(self, f)[idx] for f in _POINT_FIELDS},
+                       elastic_sphere=self.elastic_sphere)
 
     def without_group(self, group: str) -> Dataset:
         return self.subset([i for i, c in enumerate(self.curves) if c.group != group])
 
     def only_group(self, group: str) -> Dataset:
         return self.subset([i for i, c in enumerate(self.curves) if c.group == group])
+
+
+#: the per-point arrays of a :class:`Dataset` besides ``run``
+_POINT_FIELDS = ("h", "F", "a", "rho", "R", "E_prime", "p_m", "c2", "x_R", "x_rho", "h_R", "slope_F",
+                 "slope_a")
 
 
 def build_dataset_from_curves(curves: Iterable[RunCurve]) -> Dataset:

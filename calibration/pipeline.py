@@ -20,9 +20,12 @@ import dataclasses
 import hashlib
 import json
 import math
+import multiprocessing
 import os
 import time
 import warnings
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -32,7 +35,7 @@ from ..cycles import run_cycles
 from ..model.coefficients import Coefficients
 from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
-from .crossval import CVResult, RegimeFold, cross_validate_many, cross_validate_regimes
+from .crossval import CVResult, RegimeFold, fold_tasks, regime_tasks
 from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
@@ -171,12 +174,15 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
     check's grid pair of equal yield stress and E ratio 200 then kept F(h) rising decided
     between forms that ship the same for it."""
     t = time.perf_counter()
-    fits = dict(zip(candidates, pool.map(fit, [(FORMS[name],) for name in candidates]), strict=True))
-    timings["fits_s"] = time.perf_counter() - t
-    t = time.perf_counter()
-    cv = dict(zip(candidates, cross_validate_many(ds, [fits[n] for n in candidates], workers=pool),
-                  strict=True)) if cross_validation and len(ds.groups) >= 2 else {}
-    timings["cross_validation_s"] = time.perf_counter() - t
+    # the full fits, each form's folds queued as soon as its fit is known (a quick form's folds
+    # fill the workers while a slow form still fits)
+    do_cv = cross_validation and len(ds.groups) >= 2
+    done, folds = pool.run_then([(fit, (FORMS[name],)) for name in candidates],
+                                lambda i, r: fold_tasks(ds, r) if do_cv else [])
+    fits = dict(zip(candidates, done, strict=True))
+    cv = {name: CVResult(form=name, folds=f) for name, f in zip(candidates, folds, strict=True)} \
+        if do_cv else {}
+    timings["fits_and_cross_validation_s"] = time.perf_counter() - t
     t = time.perf_counter()
     mats = []
     for c in ds.curves:
@@ -236,23 +242,41 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
         for label, (r, ok) in zip(variants, done, strict=True):
             alternatives[label], alt_ok[label] = r, ok
         timings["alternatives_s"] = time.perf_counter() - t
-    regimes = []
-    if cross_validation and len(ds.curves) >= 2:
-        t = time.perf_counter()
-        regimes = cross_validate_regimes(ds, fits[chosen], workers=pool)
-        timings["regimes_s"] = time.perf_counter() - t
-    errs = [run_errors(c, fits[chosen].coeffs) for c in ds.curves]
+    # the regime folds and the diagnostics (noise floor, error bands) in one batch
     t = time.perf_counter()
-    noise = noise_floor(ds)
-    bands = breakdown(ds, fits[chosen].coeffs, fits[chosen].errors)
-    timings["diagnostics_s"] = time.perf_counter() - t
+    tasks = regime_tasks(ds, fits[chosen]) if cross_validation and len(ds.curves) >= 2 else []
+    *regimes, noise, bands = pool.run(tasks + [(noise_floor, ()),
+                                               (breakdown, (fits[chosen].coeffs, fits[chosen].errors))])
+    timings["regimes_and_diagnostics_s"] = time.perf_counter() - t
+    errs = [run_errors(c, fits[chosen].coeffs) for c in ds.curves]
     return Calibration(dataset=ds, fits=fits, cv=cv, chosen=chosen, checks=checks[chosen],
                        run_errors=errs, alternatives=alternatives, alternative_checks=alt_ok,
                        form_checks=dict(checks_ok), timings=timings, noise=noise, breakdown=bands,
                        regimes=regimes, interface=interfaces.get(chosen))
 
 
-def load_runs(db_path, include_stopped: bool = True, db=None):
+def _database_hash(db_path) -> str:
+    from spherecontact.data import Database
+
+    return Database(db_path).content_hash
+
+
+@contextmanager
+def _content_hash_aside(db_path):
+    """The database's content hash (``Database.content_hash``: every dataset read again, ~3 s)
+    computed by a forked process while this one reads the runs and calibrates; yields a function
+    that waits for it. In this process where the platform cannot fork."""
+    try:
+        ctx = multiprocessing.get_context("fork")
+    except ValueError:
+        yield lambda: _database_hash(db_path)
+        return
+    with ProcessPoolExecutor(1, mp_context=ctx) as pool:  # forked before this process opens the file
+        pending = pool.submit(_database_hash, db_path)
+        yield pending.result
+
+
+def load_runs(db_path, include_stopped: bool = True, db=None, content_hash: bool = True):
     """Calibration runs of the database: ``(runs, source)``.
 
     ``runs`` are ``(key, run)`` pairs of set "calibration" with one deformable body (scenes
@@ -264,7 +288,8 @@ def load_runs(db_path, include_stopped: bool = True, db=None):
     (:func:`source_path`), content hash, the date of the newest run used (the coefficient
     file's date, so the same database gives the same file), the keys used and those left
     out with their status.
-    ``db``: the database at ``db_path`` already opened (``spherecontact.data.Database``).
+    ``db``: the database at ``db_path`` already opened (``spherecontact.data.Database``);
+    ``content_hash`` False: ``source["content_hash"]`` left None (the caller fills it).
     Raises FileNotFoundError/ValueError (from the reader) for a missing or unreadable
     file and ValueError if it holds no usable calibration run.
     """
@@ -292,7 +317,7 @@ def load_runs(db_path, include_stopped: bool = True, db=None):
         h.update(f"{r.key}\0{r.status}\0".encode())
         for arr in (run.h, run.F, run.a):
             h.update(np.ascontiguousarray(arr, dtype="<f8").tobytes())
-    source = {"path": source_path(db_path), "content_hash": db.content_hash,
+    source = {"path": source_path(db_path), "content_hash": db.content_hash if content_hash else None,
               "calibration_runs_hash": h.hexdigest(), "date": dates[-1][:10] or None,
               "runs": [{"key": r.key, "case": r.case} for r, _ in pairs], "left_out": left_out,
               "partial": partial}
@@ -454,15 +479,17 @@ def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
     t0 = time.perf_counter()
     from spherecontact.data import Database
 
-    db = Database(db_path)  # opened once: listing its entries reads every run's attributes
-    runs, source = load_runs(db_path, include_stopped, db=db)
-    two = two_body_runs(db)
-    pairs = load_pairs(db_path, runs=two)
-    source["pairs"] = [c.name for c in pairs]
-    read_s = time.perf_counter() - t0
-    cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs,
-                         elastic_sphere=ELASTIC_SPHERE,
-                         cycle_runs=runs + [(f"{r.case} [{r.key}]", run) for r, run in two])
+    with _content_hash_aside(db_path) as content_hash:
+        db = Database(db_path)  # opened once: listing its entries reads every run's attributes
+        runs, source = load_runs(db_path, include_stopped, db=db, content_hash=False)
+        two = two_body_runs(db)
+        pairs = load_pairs(db_path, runs=two)
+        source["pairs"] = [c.name for c in pairs]
+        read_s = time.perf_counter() - t0
+        cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs,
+                             elastic_sphere=ELASTIC_SPHERE,
+                             cycle_runs=runs + [(f"{r.case} [{r.key}]", run) for r, run in two])
+        cal.source["content_hash"] = content_hash()
     cal.timings["read_s"] = read_s
     if out is not None:
         write_json(out, coefficient_file(cal))

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 from .dataset import Dataset
 
@@ -57,7 +57,28 @@ class Workers:
         _DATASET = None
 
     def map(self, fn, arglist) -> list:
-        arglist = list(arglist)
-        if self._pool is None or len(arglist) < 2:
-            return [fn(self.ds, *args) for args in arglist]
-        return list(self._pool.map(_run, [(fn, args) for args in arglist]))
+        return self.run([(fn, args) for args in arglist])
+
+    def run(self, tasks) -> list:
+        """``[fn(ds, *args) for fn, args in tasks]``: tasks of several functions in one batch."""
+        tasks = list(tasks)
+        if self._pool is None or len(tasks) < 2:
+            return [fn(self.ds, *args) for fn, args in tasks]
+        return list(self._pool.map(_run, tasks))
+
+    def run_then(self, tasks, then) -> tuple[list, list[list]]:
+        """The results of ``tasks`` (as :meth:`run`) and, for each, the results of the tasks
+        ``then(i, result)`` (a list of ``(fn, args)``), which start as soon as that result is
+        known: the follow-up tasks of a quick first task fill the workers while a slow one
+        runs. Results in submission order whatever the schedule."""
+        tasks = list(tasks)
+        if self._pool is None:
+            first = [fn(self.ds, *args) for fn, args in tasks]
+            return first, [self.run(then(i, r)) for i, r in enumerate(first)]
+        futures = [self._pool.submit(_run, t) for t in tasks]
+        index = {f: i for i, f in enumerate(futures)}
+        follow: list[list] = [[] for _ in tasks]
+        for f in as_completed(futures):
+            i = index[f]
+            follow[i] = [self._pool.submit(_run, t) for t in then(i, f.result())]
+        return [f.result() for f in futures], [[f.result() for f in fs] for fs in follow]

@@ -6,7 +6,7 @@ import pytest
 from test_calibration import KNOWN_CO, SMALL, synthetic_runs
 
 from spherecontact.calibration import fit as fitmod
-from spherecontact.calibration.crossval import cross_validate, cross_validate_many
+from spherecontact.calibration.crossval import cross_validate, cross_validate_many, fold_tasks
 from spherecontact.calibration.dataset import build_dataset
 from spherecontact.calibration.diagnostics import breakdown, noise_floor
 from spherecontact.calibration.fit import errors, fit
@@ -67,6 +67,39 @@ def test_workers_give_the_same_fits_and_folds(small_ds):
         np.testing.assert_array_equal(a.params, b.params)
         for q in ("H_bar", "c2"):
             np.testing.assert_array_equal(a.errors[q], b.errors[q])
+
+
+def test_folds_queued_behind_their_fit_are_the_serial_ones(small_ds):
+    """``Workers.run_then``: each form's folds start when its own fit is known (the calibration
+    queues them so); fits and folds are those of the serial run, in submission order."""
+    forms = (FORMS["smooth"], FORMS["seed"])
+    with Workers(small_ds, 2) as pool:
+        fits, folds = pool.run_then([(fit, (f,)) for f in forms], lambda i, r: fold_tasks(small_ds, r))
+    for form, got, got_folds in zip(forms, fits, folds, strict=True):
+        full = fit(small_ds, form)
+        np.testing.assert_array_equal(got.params, full.params)
+        serial = cross_validate(small_ds, full)
+        assert [f.group for f in got_folds] == small_ds.groups
+        for a, b in zip(serial.folds, got_folds, strict=True):
+            np.testing.assert_array_equal(a.params, b.params)
+            np.testing.assert_array_equal(a.errors["F"], b.errors["F"])
+
+
+def test_subset_is_the_dataset_built_from_its_curves(small_ds):
+    """A fold's dataset is sliced from the full one (``Dataset.subset``): the same arrays as
+    building it from the fold's curves, in the order of the runs asked for."""
+    import dataclasses
+
+    from spherecontact.calibration.dataset import build_dataset_from_curves
+    for keep in ([0, 2, 3], [3, 1], list(range(len(small_ds.curves)))[::-1]):
+        sub = small_ds.subset(keep)
+        ref = build_dataset_from_curves([small_ds.curves[i] for i in keep])
+        assert sub.curves == ref.curves
+        for f in dataclasses.fields(ref):
+            if f.name not in ("curves", "cache", "elastic_sphere"):
+                np.testing.assert_array_equal(getattr(sub, f.name), getattr(ref, f.name), err_msg=f.name)
+    with pytest.raises(ValueError, match="no calibration points"):
+        small_ds.subset([])
 
 
 def test_breakdown_shares_add_up_and_bands_cover_every_point(small_ds):
