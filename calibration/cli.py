@@ -10,6 +10,7 @@ import argparse
 import sys
 import time
 
+from .crossval import FOLD_NFEV, FOLD_TOL, FoldSolve
 from .forms import CANDIDATES, FORMS
 from .workers import DEFAULT_WORKERS
 
@@ -30,6 +31,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--workers", type=int, default=DEFAULT_WORKERS,
                    help="processes for the independent fits (folds, variants); the result does "
                         f"not depend on it (default {DEFAULT_WORKERS})")
+    p.add_argument("--fold-nfev", type=int, default=FOLD_NFEV, metavar="N",
+                   help="evaluations per cross-validation fold fit, 1-10000 (default "
+                        f"{FOLD_NFEV}; 100 with --fold-tol 1e-8 solves the folds: slower, and the "
+                        "held-out errors it reports are larger, see calibration/README.md)")
+    p.add_argument("--fold-tol", type=float, default=FOLD_TOL, metavar="TOL",
+                   help=f"stopping tolerance of a fold fit, 1e-15-1e-2 (default {FOLD_TOL:g})")
     p.add_argument("--converged-only", action="store_true",
                    help="leave out runs that stopped before h_max (default: fit their converged "
                         "increments)")
@@ -44,13 +51,18 @@ def main(argv: list[str] | None = None) -> int:
         print(f"calibrate: error: unknown form(s) {unknown}; known: {', '.join(FORMS)}",
               file=sys.stderr)
         return 2
+    try:
+        folds = FoldSolve(args.fold_nfev, args.fold_tol)
+    except ValueError as err:
+        print(f"calibrate: error: {err}", file=sys.stderr)
+        return 2
     from .pipeline import calibrate
 
     t0 = time.perf_counter()
     try:
         cal = calibrate(args.db, out=args.out, report_dir=args.report or None,
                         include_stopped=not args.converged_only, candidates=forms,
-                        workers=args.workers)
+                        workers=args.workers, folds=folds)
     except FileNotFoundError as err:
         print(f"calibrate: error: reference database not found: {err.filename or args.db}",
               file=sys.stderr)

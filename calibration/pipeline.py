@@ -35,7 +35,7 @@ from ..cycles import run_cycles
 from ..model.coefficients import Coefficients
 from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
-from .crossval import CVResult, RegimeFold, fold_tasks, regime_tasks
+from .crossval import DEFAULT_FOLDS, CVResult, FoldSolve, RegimeFold, fold_tasks, regime_tasks
 from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
@@ -109,6 +109,7 @@ class Calibration:
     regimes: list[RegimeFold] = field(default_factory=list)  # chosen form, one regime held out
     interface: InterfaceFit | None = None  # two-body interface terms (``interface.py``)
     unloading: UnloadingFit | None = None  # unloading law from the FE cycles (``unloading.py``)
+    folds: FoldSolve = field(default_factory=FoldSolve)  # how far the fold fits were solved
 
     @property
     def best(self) -> FitResult:
@@ -137,21 +138,22 @@ def _warm_start(form: Form, base: FitResult) -> np.ndarray:
 def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
                    large_deformation_options: bool = True, source: dict | None = None,
                    workers: int = DEFAULT_WORKERS, pairs=(), elastic_sphere=(),
-                   cycle_runs=()) -> Calibration:
+                   cycle_runs=(), folds: FoldSolve = DEFAULT_FOLDS) -> Calibration:
     """Fit, cross-validate, choose, check. ``runs``: iterable of ``(key, run)``; the
     independent fits run on ``workers`` processes, with one BLAS thread each whatever the
     environment says (the result depends on neither). ``pairs``: two-body runs
     (``interface.PairCurve``) for the interface terms of the chosen form (none: left out);
     ``elastic_sphere``: the FE elastic hemisphere's (h/R, F/Hertz), the Level I anchor of the fits
     (``fit.level_I_anchor``; none: no anchor); ``cycle_runs``: ``(name, run)`` whose unloading
-    cycles give the unloading law (``unloading.py``; none: left out)."""
+    cycles give the unloading law (``unloading.py``; none: left out); ``folds``: how far the
+    cross-validation's fold fits are solved (``crossval.FoldSolve``)."""
     t0 = time.perf_counter()
     with single_threaded_blas():  # the result must not depend on the BLAS thread count (threads.py)
         ds = build_dataset(runs, elastic_sphere=elastic_sphere)
         timings = {"dataset_s": time.perf_counter() - t0}
         with Workers(ds, workers) as pool:
             cal = _calibrate(ds, pool, candidates, cross_validation, large_deformation_options, timings,
-                             list(pairs))
+                             list(pairs), folds)
     cal.source = dict(source or {})
     if cycle_runs:
         t = time.perf_counter()
@@ -166,7 +168,8 @@ def calibrate_runs(runs, candidates=CANDIDATES, cross_validation: bool = True,
 
 
 def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
-               large_deformation_options: bool, timings: dict, pairs=()) -> Calibration:
+               large_deformation_options: bool, timings: dict, pairs=(),
+               folds: FoldSolve = DEFAULT_FOLDS) -> Calibration:
     """Fits, cross-validation and the choice (:func:`calibrate_runs`). With two-body ``pairs`` a
     form's monotonicity check judges the model it would ship: its body law with the interface
     terms fitted to it (``interface.py``). Without them two plastic spheres of near-equal
@@ -177,10 +180,10 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
     # the full fits, each form's folds queued as soon as its fit is known (a quick form's folds
     # fill the workers while a slow form still fits)
     do_cv = cross_validation and len(ds.groups) >= 2
-    done, folds = pool.run_then([(fit, (FORMS[name],)) for name in candidates],
-                                lambda i, r: fold_tasks(ds, r) if do_cv else [])
+    done, fold_results = pool.run_then([(fit, (FORMS[name],)) for name in candidates],
+                                lambda i, r: fold_tasks(ds, r, folds.nfev, folds.tol) if do_cv else [])
     fits = dict(zip(candidates, done, strict=True))
-    cv = {name: CVResult(form=name, folds=f) for name, f in zip(candidates, folds, strict=True)} \
+    cv = {name: CVResult(form=name, folds=f) for name, f in zip(candidates, fold_results, strict=True)} \
         if do_cv else {}
     timings["fits_and_cross_validation_s"] = time.perf_counter() - t
     t = time.perf_counter()
@@ -244,7 +247,8 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
         timings["alternatives_s"] = time.perf_counter() - t
     # the regime folds and the diagnostics (noise floor, error bands) in one batch
     t = time.perf_counter()
-    tasks = regime_tasks(ds, fits[chosen]) if cross_validation and len(ds.curves) >= 2 else []
+    tasks = (regime_tasks(ds, fits[chosen], folds.nfev, folds.tol)
+             if cross_validation and len(ds.curves) >= 2 else [])
     *regimes, noise, bands = pool.run(tasks + [(noise_floor, ()),
                                                (breakdown, (fits[chosen].coeffs, fits[chosen].errors))])
     timings["regimes_and_diagnostics_s"] = time.perf_counter() - t
@@ -252,7 +256,7 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
     return Calibration(dataset=ds, fits=fits, cv=cv, chosen=chosen, checks=checks[chosen],
                        run_errors=errs, alternatives=alternatives, alternative_checks=alt_ok,
                        form_checks=dict(checks_ok), timings=timings, noise=noise, breakdown=bands,
-                       regimes=regimes, interface=interfaces.get(chosen))
+                       regimes=regimes, interface=interfaces.get(chosen), folds=folds)
 
 
 def _database_hash(db_path) -> str:
@@ -423,6 +427,9 @@ def coefficient_file(cal: Calibration) -> dict:
         "cross_validation": {n: {q: {k: _stat(v) for k, v in s.items()}
                                  for q, s in cv.pooled().items()} | {"score": _stat(cv_score(cv))}
                              for n, cv in cal.cv.items()},
+        "cross_validation_folds": {"max_nfev": cal.folds.nfev, "tol": cal.folds.tol,
+                                   "note": "each fold fit warm-started from the full fit and stopped "
+                                           "after max_nfev evaluations or at tol (crossval.FoldSolve)"},
         "cross_validation_regimes": {
             f"{r.family}: {r.label}": {"runs": r.runs} | {
                 q: {"rms": _stat(rms(r.errors[q])), "max": _stat(float(np.max(np.abs(r.errors[q]))))}
@@ -474,7 +481,8 @@ def write_json(path, d: dict) -> Path:
 
 
 def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
-              candidates=CANDIDATES, workers: int = DEFAULT_WORKERS) -> Calibration:
+              candidates=CANDIDATES, workers: int = DEFAULT_WORKERS,
+              folds: FoldSolve = DEFAULT_FOLDS) -> Calibration:
     """Calibrate from the database at ``db_path``; write the coefficient file and the report."""
     t0 = time.perf_counter()
     from spherecontact.data import Database
@@ -488,7 +496,8 @@ def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
         read_s = time.perf_counter() - t0
         cal = calibrate_runs(runs, candidates=candidates, source=source, workers=workers, pairs=pairs,
                              elastic_sphere=ELASTIC_SPHERE,
-                             cycle_runs=runs + [(f"{r.case} [{r.key}]", run) for r, run in two])
+                             cycle_runs=runs + [(f"{r.case} [{r.key}]", run) for r, run in two],
+                             folds=folds)
         cal.source["content_hash"] = content_hash()
     cal.timings["read_s"] = read_s
     if out is not None:

@@ -167,3 +167,21 @@ def test_jacobian_equals_central_differences(name):
             cd = (res(xp) - res(xm)) / (2.0 * h)
             scale = max(1e-3, float(np.abs(cd).max()))
             assert np.abs(J[:, j] - cd).max() < 2e-5 * scale, (name, form.names[j])
+
+
+def test_fold_solve_is_checked_and_reaches_the_folds(small_ds):
+    """``FoldSolve`` (``--fold-nfev``, ``--fold-tol``): bad values are refused naming the parameter;
+    a fold capped at one evaluation stays at the full fit, a solved one moves away from it."""
+    from spherecontact.calibration import cli
+    from spherecontact.calibration.crossval import FoldSolve, fold_fit
+
+    for bad in ({"nfev": 0}, {"nfev": 2.5}, {"tol": 0.5}, {"tol": 0.0}):
+        with pytest.raises(ValueError, match="fold (nfev|tol)"):
+            FoldSolve(**bad)
+    assert cli.main(["--fold-nfev", "0", "--db", "nowhere.h5"]) == 2
+    assert cli.main(["--fold-tol", "1", "--db", "nowhere.h5"]) == 2
+    full = fit(small_ds, FORMS["smooth"])
+    group = small_ds.groups[0]
+    capped = fold_fit(small_ds, full.form, full.params, full.coeff_dict, group, 1)
+    solved = fold_fit(small_ds, full.form, full.params, full.coeff_dict, group, 200, 1e-10)
+    assert np.max(np.abs(capped.params - full.params)) < np.max(np.abs(solved.params - full.params))
