@@ -398,6 +398,14 @@ def continued_log(x, x_max):
         return xc, u, np.log(xc)
 
 
+def poly_with_n(b, bn, n: float) -> tuple[float, ...]:
+    """The coefficients b_k + n bn_k of a polynomial with per-n terms at one n (the shorter
+    tuple padded with zeros)."""
+    k = max(len(b), len(bn))
+    return tuple(c + n * d for c, d in zip(tuple(b) + (0.0,) * (k - len(b)),
+                                           tuple(bn) + (0.0,) * (k - len(bn)), strict=True))
+
+
 def _poly_and_slope(x, poly: tuple[float, ...]):
     """Σ_k c_k x^(k+1) and its log slope x d/dx = Σ_k (k+1) c_k x^(k+1)."""
     if not poly:
@@ -508,12 +516,9 @@ class CollapseLimit:
         if self.zn_poly:
             szn, dzn = _z_terms(z, z_max, self.zn_poly)
             sz, dz = sz + n * szn, dz + n * dzn
-        k = max(len(self.x_poly), len(self.xn_poly))
-        x_poly = tuple(c + n * d for c, d in zip(self.x_poly + (0.0,) * (k - len(self.x_poly)),
-                                                 self.xn_poly + (0.0,) * (k - len(self.xn_poly)),
-                                                 strict=True))
         const = math.log(self.prefactor) + float(sz) + math.log(float(_exp_poly(1.0, self.exp_poly, n)))
-        return CollapseLimitAt(log_const=const, exponent=self.exponent, x_poly=x_poly, dlnL_dz=float(dz))
+        return CollapseLimitAt(log_const=const, exponent=self.exponent,
+                               x_poly=poly_with_n(self.x_poly, self.xn_poly, n), dlnL_dz=float(dz))
 
     def to_dict(self) -> dict:
         return {"prefactor": self.prefactor, "exponent": self.exponent,

@@ -33,7 +33,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .coefficients import Coefficients, continue_beyond, continued_log
+from .coefficients import Coefficients, _poly_and_slope, continue_beyond, continued_log, poly_with_n
 
 __all__ = [
     "C2_HERTZ",
@@ -117,15 +117,6 @@ def _level_II(Lambda, q_I, q_III, coeffs: Coefficients, shape, m0=0.0, shape_n=(
     return q_I + (q_III - q_I) * s, (q_III - q_I) * ds / L
 
 
-def _with_n(b: tuple[float, ...], bn: tuple[float, ...], n: float) -> tuple[float, ...]:
-    """The shape coefficients b_k + bn_k n at one hardening exponent n (``_shape``)."""
-    if not bn:
-        return tuple(b)
-    m = max(len(b), len(bn))
-    b, bn = tuple(b) + (0.0,) * (m - len(b)), tuple(bn) + (0.0,) * (m - len(bn))
-    return tuple(c + n * d for c, d in zip(b, bn, strict=True))
-
-
 def level_t(Lambda, coeffs: Coefficients) -> np.ndarray:
     """t = ln(Λ/Λ_I)/ln(Λ_III/Λ_I) clipped to [0, 1]: the Level II coordinate (0 in Level I,
     1 in Level III) that the shapes and the level weight read."""
@@ -164,9 +155,9 @@ def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_I
         t = level_t(Lam, coeffs)
     H_I = coeffs.H_bar_I
     m0 = _m0_H(coeffs, H_III) if coeffs.level_II_smooth else 0.0
-    shapes = [(_with_n(coeffs.H_bar_shape, coeffs.H_bar_shape_n, n), m0)]
+    shapes = [(poly_with_n(coeffs.H_bar_shape, coeffs.H_bar_shape_n, n), m0)]
     if with_c2:
-        shapes.append((_with_n(coeffs.c2_shape, coeffs.c2_shape_n, n), 0.0))
+        shapes.append((poly_with_n(coeffs.c2_shape, coeffs.c2_shape_n, n), 0.0))
     if coeffs.level_II_smooth:
         shapes = _smooth_shapes(t, shapes)
     else:
@@ -220,21 +211,16 @@ def finite_size_factor(x, poly: tuple[float, ...], x_max: float | None = None):
     largest calibrated ratio) ln f is continued to a constant (:func:`continue_beyond`), so a
     polynomial fitted up to x_max never turns f negative or F(h) non-monotone at large x.
     """
-    x = np.asarray(x, dtype=float)
-    if not poly:
-        return np.ones_like(x), np.zeros_like(x)
-    return _factor_continued(*continue_beyond(x, x_max), poly, x_max is not None)
+    return _factor_continued(*continue_beyond(np.asarray(x, dtype=float), x_max), poly,
+                             x_max is not None)
 
 
 def _factor_continued(xc, u, poly: tuple[float, ...], continued: bool):
     """:func:`finite_size_factor` from x_c and u of ``continue_beyond`` (shared by the factors
-    of one x; ``poly`` not empty)."""
-    k = len(poly) - 1
-    s = poly[k] * xc            # Σ c_k x^(k+1), Horner from the top
-    ds = ((k + 1) * poly[k]) * xc  # Σ (k+1) c_k x^(k+1)
-    for k in range(len(poly) - 2, -1, -1):
-        s = (s + poly[k]) * xc
-        ds = (ds + (k + 1) * poly[k]) * xc
+    of one x)."""
+    if not poly:
+        return np.ones_like(xc), np.zeros_like(xc)
+    s, ds = _poly_and_slope(xc, poly)  # Σ c_k x^(k+1) and Σ (k+1) c_k x^(k+1)
     f = 1.0 + s
     slope = ds / f
     if not continued:
@@ -284,14 +270,14 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     zero = np.zeros_like(H_hs)
     if not coeffs.has_collapse:
         return CollapseBlend(H_hs, c2_hs, zero, zero, zero, zero, zero, zero, zero)
-    xm, zm = coeffs.x_fit_max, coeffs.collapse_z(coeffs.z_fit_max)
-    zv = coeffs.collapse_z(z)  # the z-polynomials' variable (``collapse.z_variable``)
+    xm = coeffs.x_fit_max
     if fixed:  # the n- and z-terms summed once per body law (``CollapseLimit.at``)
-        zv, zm = float(zv), float(zm)
         cont = continued_log(x, xm)  # shared by both limits
-        lnHc, sHc, zHc = coeffs.collapse_H_bar.at(n, zv, zm).log_and_slope(x, xm, cont)
-        lncc, scc, zcc = coeffs.collapse_c2.at(n, zv, zm).log_and_slope(x, xm, cont)
+        lnHc, sHc, zHc = _limit_at(coeffs.collapse_H_bar, coeffs, n, z).log_and_slope(x, xm, cont)
+        lncc, scc, zcc = _limit_at(coeffs.collapse_c2, coeffs, n, z).log_and_slope(x, xm, cont)
     else:
+        zm = coeffs.collapse_z(coeffs.z_fit_max)
+        zv = coeffs.collapse_z(z)  # the z-polynomials' variable (``collapse.z_variable``)
         lnHc, sHc, zHc = coeffs.collapse_H_bar.log_and_slope(x, n, zv, xm, zm)
         lncc, scc, zcc = coeffs.collapse_c2.log_and_slope(x, n, zv, xm, zm)
     if coeffs.collapse_z_variable != "z":  # d/dz = d/dζ · dζ/dz
@@ -300,6 +286,12 @@ def collapse_blend(H_hs, c2_hs, x, coeffs: Coefficients, n=0.0, z=0.0) -> Collap
     H, c, w, gap, wc = blend_from_logs(H_hs, c2_hs, lnHc, lncc, coeffs.collapse_sharpness,
                                        coeffs.collapse_sharpness_c2, coeffs.collapse_offset_c2)
     return CollapseBlend(H, c, w, sHc, gap, scc, zHc + zero, zcc + zero, wc)
+
+
+def _limit_at(limit, coeffs: Coefficients, n: float, z: float):
+    """A collapse limit of ``coeffs`` at one n and one curvature ratio z (``CollapseLimit.at``,
+    the z-polynomials' variable and its fitted end from ``coeffs``)."""
+    return limit.at(float(n), float(coeffs.collapse_z(z)), float(coeffs.collapse_z(coeffs.z_fit_max)))
 
 
 def _weight(z):
@@ -335,9 +327,7 @@ def _blend_H(H_hs, lnHc, k: float):
 def collapse_pressure(H_hs, x, coeffs: Coefficients, n: float, z: float):
     """The H̄ half of :func:`collapse_blend` for one body law (n, z numbers; ``coeffs`` with a
     collapse block): the blended H̄, the weight w and d ln H̄_c/d ln x."""
-    zm = float(coeffs.collapse_z(coeffs.z_fit_max))
-    at = coeffs.collapse_H_bar.at(float(n), float(coeffs.collapse_z(z)), zm)
-    lnHc, sHc, _ = at.log_and_slope(x, coeffs.x_fit_max)
+    lnHc, sHc, _ = _limit_at(coeffs.collapse_H_bar, coeffs, n, z).log_and_slope(x, coeffs.x_fit_max)
     H, w, _ = _blend_H(np.asarray(H_hs, dtype=float), lnHc, coeffs.collapse_sharpness)
     return H, w, sHc
 
@@ -448,13 +438,9 @@ def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[fl
     if elastic == plastic:
         f, dx = finite_size_factor(x, elastic, x_max)
         return f, dx, np.zeros_like(f)
-    if elastic and plastic:  # one continuation for both
-        xc, u = continue_beyond(x, x_max)
-        fe, de = _factor_continued(xc, u, elastic, x_max is not None)
-        fp, dp = _factor_continued(xc, u, plastic, x_max is not None)
-    else:
-        fe, de = finite_size_factor(x, elastic, x_max)
-        fp, dp = finite_size_factor(x, plastic, x_max)
+    xc, u = continue_beyond(x, x_max)  # one continuation for both
+    fe, de = _factor_continued(xc, u, elastic, x_max is not None)
+    fp, dp = _factor_continued(xc, u, plastic, x_max is not None)
     f = (1.0 - s) * fe + s * fp
     return f, ((1.0 - s) * fe * de + s * fp * dp) / f, (fp - fe) * ds / f
 

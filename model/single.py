@@ -150,7 +150,9 @@ def representative_stress(material: Material, eps, spread: float = 0.0):
         ef = f * e
         s = material.flow_stress(ef)
         sig = sig + w * s
-        if not elastic:  # flow_log_slope(material, ef), its σ_f(ε_f) not evaluated twice
+        if not elastic:  # flow_log_slope(material, ef) · σ_f, σ_f(ε_f) not evaluated twice (the
+            # product kept as it was written: ε σ_f' alone differs in the last bit, which moves the
+            # fitted coefficients in their 4th digit, calibration/README.md)
             dsig = dsig + w * (ef * material.flow_slope(ef) / s) * s
     with np.errstate(invalid="ignore", divide="ignore"):
         m = np.zeros_like(e) if elastic else np.where(sig > 0.0, dsig / sig, 0.0)
