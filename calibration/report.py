@@ -11,8 +11,6 @@ large-deformation range), ``residuals.png`` (relative residuals against Λ and a
 from __future__ import annotations
 
 import math
-import multiprocessing
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import NamedTuple
 
@@ -24,6 +22,7 @@ from .dataset import quantities
 from .fit import rms
 from .forms import predict
 from .pipeline import Calibration, cv_score
+from .workers import Workers
 
 __all__ = ["write_report"]
 
@@ -51,36 +50,26 @@ class _Context(NamedTuple):
     colours: dict
 
 
-_CONTEXT: _Context | None = None  # the charts' context of the forked processes (inherited)
-
-
-def _draw(chart) -> str:
+def _draw(ctx: _Context, chart) -> str:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    return chart(_CONTEXT, plt)
+    return chart(ctx, plt)
 
 
 def _plots(cal: Calibration, out: Path) -> list[str]:
-    """Every chart, on two forked processes when the platform can fork (each chart is drawn by
-    one process; ~2 s of the report's ~4.5 s on the reference machine)."""
-    global _CONTEXT
+    """Every chart, on two forked processes that inherit the shared context (``workers.Workers``;
+    each chart is drawn by one process: ~2 s of the report's ~4.5 s on the reference machine)."""
     ds, co = cal.dataset, cal.best.coeffs
     q = quantities(ds, co.beta, co.beta_growth, co.strain_spread)
     p_mod, c_mod = predict(ds, co)
-    _CONTEXT = _Context(cal, out, q, p_mod / q["sigma_rep"], c_mod, _style(cal))
     charts = [_chart_lambda, _chart_aR, _chart_residuals, _chart_model_error]
     if cal.cv:
         charts.append(_parameters_chart)
-    try:
-        if "fork" in multiprocessing.get_all_start_methods():
-            with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("fork")) as pool:
-                return list(pool.map(_draw, charts))
-        return [_draw(c) for c in charts]
-    finally:
-        _CONTEXT = None
+    with Workers(_Context(cal, out, q, p_mod / q["sigma_rep"], c_mod, _style(cal)), 2) as pool:
+        return pool.map(_draw, [(c,) for c in charts])
 
 
 def _chart_lambda(ctx: _Context, plt) -> str:

@@ -6,7 +6,8 @@ problems on the same dataset. :class:`Workers` maps a module-level function over
 argument tuples, on ``workers`` forked processes that inherit the dataset (it is not
 sent with every task), or in this process with ``workers=1``. Every task is
 deterministic and single-threaded (BLAS threads are pinned to 1), and results come back
-in submission order, so the output does not depend on the number of workers.
+in submission order, so the output does not depend on the number of workers. What the
+tasks share need not be a dataset: the report's charts share their drawing context the same way.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ __all__ = ["DEFAULT_WORKERS", "Workers"]
 #: worker processes by default: the two cores of the reference machine (at most os.cpu_count())
 DEFAULT_WORKERS = 2
 
-_DATASET: Dataset | None = None  # the dataset of the pool being forked (inherited, not pickled)
+_DATASET: Dataset | object | None = None  # what the tasks share, of the pool being forked (inherited)
 
 
 def _run(task):
@@ -37,7 +38,7 @@ class Workers:
     platform cannot fork, or when only one task is given.
     """
 
-    def __init__(self, ds: Dataset, workers: int = DEFAULT_WORKERS) -> None:
+    def __init__(self, ds: Dataset | object, workers: int = DEFAULT_WORKERS) -> None:
         self.ds = ds
         self.workers = max(1, min(int(workers), os.cpu_count() or 1))
         self._pool: ProcessPoolExecutor | None = None
