@@ -21,6 +21,7 @@ import numpy as np
 from ..model.material import Material
 from .assembly import ELEMENTS
 from .io import SCENES, check_inputs, run_indentation, write_run
+from .linsolve import METHODS as LINEAR_METHODS
 from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN
 from .solver import PENALTY_SCALES, SolverOptions
 
@@ -301,9 +302,10 @@ def _add_numerics(add) -> None:
              "in by about h / penalty at every approach (use with --segment-points; README, "
              "'Smoothness of F'). With penalty contact the curve h is the body's own shortening "
              "and h_applied the obstacle's travel")
-    add(grp, "--linear-solver", choices=("ldl", "superlu"), default="ldl",
-        help="sparse factorisation: 'ldl' (qdldl LDL^T reusing its ordering, SuperLU where it "
-             "fails; default) or 'superlu'")
+    add(grp, "--linear-solver", choices=LINEAR_METHODS, default=_DEFAULTS.linear_solver,
+        help="sparse factorisation: 'cholesky' (CHOLMOD's supernodal Cholesky reusing its "
+             "analysis, LDL^T where the tangent is not positive definite; default), 'ldl' (qdldl "
+             "LDL^T reusing its ordering, SuperLU where it fails) or 'superlu'")
 
 
 def _add_output(add) -> None:

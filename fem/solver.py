@@ -30,6 +30,7 @@ import numpy as np
 from ..model.material import Material
 from .assembly import Discretisation, positive_jacobian
 from .contact import RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
+from .linsolve import METHODS as LINEAR_METHODS
 from .linsolve import ConstrainedPattern, SymmetricSolver
 from .mesh import build_mesh
 from .plasticity import PlasticState, stress_update, tangent
@@ -107,8 +108,10 @@ class SolverOptions:
     #: k_N = penalty · E / ℓ per unit reference area, ℓ the length of the pole's surface element
     #: (two bodies: E* of the pair, symmetric two-pass; twobody.py)
     penalty: float | None = None
-    #: "ldl": qdldl LDLᵀ reusing its symbolic analysis, SuperLU where it fails; "superlu": SuperLU only
-    linear_solver: str = "ldl"
+    #: "cholesky": CHOLMOD's supernodal Cholesky reusing its symbolic analysis, LDLᵀ where the
+    #: tangent is not positive definite; "ldl": qdldl LDLᵀ reusing its symbolic analysis, SuperLU
+    #: where it fails; "superlu": SuperLU only (``linsolve.SymmetricSolver``)
+    linear_solver: str = "cholesky"
     #: "tangent": the last converged increment's factorised tangent applied to the new approach
     #: step (:meth:`IndentationSolver._tangent_predictor`), the secant where it is not at hand;
     #: "secant": the last increment's displacement change extrapolated
@@ -157,8 +160,9 @@ class SolverOptions:
         if not (isinstance(self.unload_increments, int) and 4 <= self.unload_increments <= 1000):
             raise ValueError(f"unload_increments must be an integer in [4, 1000], got "
                              f"{self.unload_increments!r}")
-        if self.linear_solver not in ("ldl", "superlu"):
-            raise ValueError(f"linear_solver must be 'ldl' or 'superlu', got {self.linear_solver!r}")
+        if self.linear_solver not in LINEAR_METHODS:
+            raise ValueError(f"linear_solver must be one of {', '.join(map(repr, LINEAR_METHODS))}, "
+                             f"got {self.linear_solver!r}")
         if self.predictor not in ("tangent", "secant"):
             raise ValueError(f"predictor must be 'tangent' or 'secant', got {self.predictor!r}")
         if self.penalty is not None and not (isinstance(self.penalty, (int, float))

@@ -6,9 +6,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from spherecontact.fem.contact import RigidObstacle
-from spherecontact.fem.linsolve import ConstrainedPattern, SymmetricSolver
+from spherecontact.fem.linsolve import ConstrainedPattern, SupernodalCholesky, SymmetricSolver
 from spherecontact.fem.solver import IndentationSolver, SolverOptions
 from spherecontact.model import Material
+
+NONE = {"cholesky_fresh": 0, "cholesky_update": 0, "not_definite": 0, "ldl_fresh": 0, "ldl_update": 0,
+        "fallback": 0, "superlu": 0}
 
 
 def _laplacian(n: int, shift: float = 0.1) -> sp.csr_matrix:
@@ -25,7 +28,7 @@ def test_ldl_reuses_its_analysis_and_matches_superlu():
     x2 = s.solve(K * 2.0, b)  # same pattern, new values: numeric refactorisation only
     assert np.allclose(x1, spla.spsolve(K.tocsc(), b), rtol=1e-10, atol=1e-12)
     assert np.allclose(x2, 0.5 * x1, rtol=1e-10, atol=1e-12)
-    assert s.stats == {"ldl_fresh": 1, "ldl_update": 1, "fallback": 0, "superlu": 0}
+    assert s.stats == {**NONE, "ldl_fresh": 1, "ldl_update": 1}
 
 
 def test_a_moving_pattern_settles_on_the_union_of_the_patterns_seen():
@@ -107,7 +110,7 @@ def test_solve_upper_reuses_its_analysis_per_key_and_falls_back_on_a_zero_pivot(
     x1 = s.solve_upper(*pattern.upper(K.data, none, 1.0), b, pattern)
     x2 = s.solve_upper(*pattern.upper(2.0 * K.data, none, 1.0), b, pattern)
     assert np.allclose(x2, 0.5 * x1, rtol=1e-10)
-    assert s.stats == {"ldl_fresh": 1, "ldl_update": 1, "fallback": 0, "superlu": 0}
+    assert s.stats == {**NONE, "ldl_fresh": 1, "ldl_update": 1}
     # a zero diagonal entry first (LDLᵀ without pivoting breaks down): SuperLU answers
     A = K.copy()
     A.data[(np.repeat(np.arange(A.shape[0]), np.diff(A.indptr)) == A.indices) & (A.indices == 0)] = 0.0
@@ -118,19 +121,48 @@ def test_solve_upper_reuses_its_analysis_per_key_and_falls_back_on_a_zero_pivot(
     assert s.stats["fallback"] == 1
 
 
+def test_cholesky_reuses_its_analysis_keeps_explicit_zeros_and_gives_way_to_ldl():
+    """The supernodal Cholesky on the constrained pattern: the reduced solution (the fixed rows
+    and columns held as explicit zeros), a second matrix on the same analysis, and a matrix that
+    is not positive definite refused and solved by LDLᵀ instead, counted."""
+    K = _laplacian(8)
+    K.sort_indices()
+    n = K.shape[0]
+    pattern = ConstrainedPattern(K.indptr, K.indices)
+    fixed = np.array([0, 9, 30])
+    U, diag = pattern.upper(K.data, fixed, 2.0)
+    chol = SupernodalCholesky(U)
+    chol.factor(U)
+    b = np.linspace(-1.0, 1.0, n)
+    assert np.abs(_full(U, diag) @ chol.solve(b) - b).max() < 1e-12
+    s = SymmetricSolver("cholesky")
+    x1 = s.solve_upper(U, diag, b, pattern)
+    x2 = s.solve_upper(*pattern.upper(3.0 * K.data, fixed, 6.0), b, pattern)
+    assert np.allclose(x2, x1 / 3.0, rtol=1e-12)
+    assert np.allclose(s.resolve(b), x2, rtol=1e-12)  # the tangent predictor's solve, no refactorisation
+    assert s.stats == {**NONE, "cholesky_fresh": 1, "cholesky_update": 1}
+    shifted = K - 0.5 * sp.eye(n, format="csr")  # the Laplacian's lowest eigenvalue is ~0.24
+    shifted.sort_indices()
+    U, diag = pattern.upper(shifted.data, fixed, 1.0)
+    x = s.solve_upper(U, diag, b, pattern)
+    assert np.abs(_full(U, diag) @ x - b).max() < 1e-9
+    assert s.stats["not_definite"] == 1 and s.stats["ldl_fresh"] == 1 and s.stats["fallback"] == 0
+
+
 def test_bad_method_is_named():
-    with pytest.raises(ValueError, match="method"):
+    with pytest.raises(ValueError, match="'cholesky', 'ldl', 'superlu'"):
         SymmetricSolver("cholmod")
     with pytest.raises(ValueError, match="linear_solver"):
         SolverOptions(linear_solver="pardiso").validate()
 
 
 @pytest.mark.parametrize("indenter", [np.inf, 1.5])
-def test_ldl_and_superlu_give_the_same_run(indenter):
-    """Flat (constrained z dofs) and rigid sphere (nodal frames rotated in place): the LDLᵀ
-    path keeps one symbolic analysis for the whole run and reproduces SuperLU's answer."""
+def test_cholesky_ldl_and_superlu_give_the_same_run(indenter):
+    """Flat (constrained z dofs) and rigid sphere (nodal frames rotated in place): the Cholesky
+    and LDLᵀ paths keep one symbolic analysis each for the whole run and reproduce SuperLU's
+    answer."""
     runs = {}
-    for method in ("ldl", "superlu"):
+    for method in ("cholesky", "ldl", "superlu"):
         s = IndentationSolver(Material(E=200.0, nu=0.3, sigma_y=1.0), 1.0, RigidObstacle(indenter),
                               density=0.5, options=SolverOptions(linear_solver=method))
         runs[method] = s.run(0.004)
@@ -142,6 +174,12 @@ def test_ldl_and_superlu_give_the_same_run(indenter):
     # every later factorisation (rejected increments' included) reuses the first analysis
     assert a.timings["linear_ldl_update"] >= a.timings["newton_iterations"] - 1
     assert a.timings["linear_fallback"] == 0 and b.timings["linear_superlu"] >= b.timings["newton_iterations"]
+    c = runs["cholesky"]
+    assert np.array_equal(c.curves["iterations"], b.curves["iterations"])
+    assert np.allclose(c.F, b.F, rtol=1e-9)
+    assert c.timings["linear_cholesky_fresh"] == 1
+    assert c.timings["linear_cholesky_update"] >= c.timings["newton_iterations"] - 1
+    assert c.timings["linear_fallback"] == 0
 
 
 def _saddle(n: int = 6, m: int = 3, seed: int = 0):
@@ -164,7 +202,7 @@ def test_the_saddle_point_system_the_plain_ldl_cannot_factor_is_solved_by_regula
     assert np.allclose(x, spla.spsolve(A, b), rtol=1e-10, atol=1e-12)
     x2 = s.solve_saddle(2.0 * A, b, 3)
     assert np.allclose(x2, 0.5 * x, rtol=1e-10, atol=1e-12)
-    assert s.stats == {"ldl_fresh": 1, "ldl_update": 1, "fallback": 0, "superlu": 0}
+    assert s.stats == {**NONE, "ldl_fresh": 1, "ldl_update": 1}
 
 
 def test_the_regularisation_is_refined_away(monkeypatch):
@@ -207,7 +245,7 @@ def test_saddle_and_plain_solves_share_one_solver():
     assert s.stats["fallback"] == 0 and s.stats["ldl_fresh"] == 4 and s.stats["ldl_update"] == 1
 
 
-@pytest.mark.parametrize("method", ["ldl", "superlu"])
+@pytest.mark.parametrize("method", ["cholesky", "ldl", "superlu"])
 def test_resolve_reuses_the_factors_of_the_last_accepted_solution(method):
     K = _laplacian(12)
     rng = np.random.default_rng(1)
