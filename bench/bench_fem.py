@@ -1,11 +1,12 @@
 """FE speed: the standard run (EPP, E/σY = 200, ν = 0.3, rigid flat, h/R = 0.3, default mesh).
 
-Runs it four times (the first twice, keeping the faster): as it stands (tangent predictor, CHOLMOD's supernodal Cholesky reusing its
-symbolic analysis, Newton tolerance 1e-4), with qdldl's LDLᵀ instead (the factorisation before
-Cholesky), with the previous predictor (``predictor="secant"``), and with SuperLU alone (the
-solver before LDLᵀ), and reports for each the wall time, increments, Newton iterations,
-the split per iteration (constitutive update, assembly, contact, constraint
-setup, factorisation, triangular solves, line search) and the FE scatter of
+Runs it four times (the first twice, keeping the faster): as it stands (tangent predictor,
+CHOLMOD's supernodal Cholesky reusing its symbolic analysis, Newton tolerance 1e-4), with
+qdldl's LDLᵀ instead (the factorisation before Cholesky), with the previous predictor
+(``predictor="secant"``), and with SuperLU alone (the solver before LDLᵀ), and reports for
+each the wall time, increments, Newton iterations, the split per iteration (constitutive
+update, assembly, contact, constraint setup, factorisation, triangular solves, line search)
+and the FE scatter of
 F and a over h/R ≥ 0.01 (max |ln y − local quadratic in ln h| over 11
 increments). Target (issue "FE reference v2"): ≤ 25 s alone, ≤ 5 iterations
 per increment. Then ``smooth``: the same scene on the surface-band mesh (0.03)
