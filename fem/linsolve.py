@@ -86,8 +86,7 @@ class SupernodalCholesky:
     def factor(self, U: sp.csc_matrix) -> None:
         """Numeric factorisation of the matrix with upper triangle U (the analysed pattern)."""
         self._A.V = _cvx_matrix(U.data[self._take])
-        _cholmod.options["supernodal"] = 2
-        _cholmod.numeric(self._A, self._F)
+        _cholmod.numeric(self._A, self._F)  # supernodal: the analysis chose it
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         x = _cvx_matrix(np.asarray(b, dtype=float))
