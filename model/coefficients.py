@@ -219,6 +219,9 @@ class UnloadingCoefficients:
     stiffness_c2_counter: float = 0.0
     stiffness_c2_depth: float = 0.0
     stiffness_c2_c2: float = 0.0
+    #: m_Uz: a deep dent under a curved counter-surface unloads with the exponent lowered by
+    #: m_Uz U z̄² at the same elastic recovery δ_e (the term is left out of δ_e = m F C/s₀)
+    m_counter_depth: float = 0.0
 
     def to_dict(self) -> dict:
         return {k: getattr(self, k) for k in UNLOADING_RANGES}
@@ -232,10 +235,10 @@ UNLOADING_RANGES = {"stiffness": (0.5, 2.0), "size_a": (0.0, 10.0), "size_h": (0
                     "m_elastic_size": (-1.0, 3.0), "elastic_weight": (0.1, 20.0),
                     "size_counter": (0.0, 1.0), "stiffness_c2": (-0.5, 0.5), "m_lambda": (-1.0, 1.0),
                     "stiffness_c2_counter": (-2.0, 2.0), "stiffness_c2_depth": (-2.0, 2.0),
-                    "stiffness_c2_c2": (-2.0, 2.0)}
+                    "stiffness_c2_c2": (-2.0, 2.0), "m_counter_depth": (-3.0, 3.0)}
 #: keys of the ``unloading`` section an older file may leave out (absent: 0, the law without them)
 UNLOADING_OPTIONAL = ("size_counter", "stiffness_c2", "m_lambda", "stiffness_c2_counter",
-                      "stiffness_c2_depth", "stiffness_c2_c2")
+                      "stiffness_c2_depth", "stiffness_c2_c2", "m_counter_depth")
 
 #: allowed ranges of the ``interface`` section's numbers
 _INTERFACE_RANGES = {"coupling": (0.0, 1000.0), "similarity": (0.01, 10.0), "radius": (0.01, 100.0),

@@ -117,6 +117,20 @@ def test_plastic_exponent_grows_with_lambda():
     np.testing.assert_allclose(m1 - m0, 0.5 * f.lam * (1 - w) * (1 - f.U), rtol=1e-12)
 
 
+def test_deep_dent_exponent_leaves_the_recovery_alone():
+    """m = m₀ + (1 − w) m_Uz U z̄² with δ_e = m₀ F C/s₀: the term lowers m by exactly that, keeps
+    δ_e and h_res, and does nothing on a flat (U = 0)."""
+    f = _peaks()
+    assert f.U[0] == 0.0 and f.U[1] > 0.0
+    w = f.lam ** BASE.elastic_weight
+    m0, d0, r0, _ = unloading_law(f, BASE)
+    m1, d1, r1, _ = unloading_law(f, replace(BASE, m_counter_depth=-0.7))
+    np.testing.assert_allclose(m1 - m0, -0.7 * (1 - w) * f.U * f.z[:, 0] ** 2, rtol=1e-12, atol=1e-15)
+    assert m1[0] == m0[0] and m1[1] < m0[1]
+    np.testing.assert_array_equal(d1, d0)
+    np.testing.assert_array_equal(r1, r0)
+
+
 def test_branch_is_continuous_at_the_peak_and_vanishes_at_h_res(co):
     s1 = Sphere(1.0, EPP)
     for hm in (1e-3, 0.03, 0.3):
@@ -296,7 +310,7 @@ def test_an_older_unloading_section_gives_the_law_without_the_new_terms(co):
     """Files written before size_counter, stiffness_c2 and m_lambda leave them out: 0."""
     d = co.to_dict()
     new = dict(d["unloading"], size_counter=0.5, stiffness_c2=0.1, m_lambda=0.2, stiffness_c2_counter=-0.3,
-               stiffness_c2_depth=-0.1, stiffness_c2_c2=-0.2)
+               stiffness_c2_depth=-0.1, stiffness_c2_c2=-0.2, m_counter_depth=-0.7)
     older = {k: v for k, v in new.items() if k not in UNLOADING_OPTIONAL}
     law_old = Coefficients.from_dict(dict(d, unloading=older)).unloading
     assert law_old == replace(Coefficients.from_dict(dict(d, unloading=new)).unloading,

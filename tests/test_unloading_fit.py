@@ -53,7 +53,8 @@ def test_fit_recovers_a_known_law(curves):
     known = UnloadingCoefficients(stiffness=1.2, size_a=0.5, size_h=1.5, m_plastic=1.25, m_c2=0.2,
                                   m_counter=1.4, m_elastic_size=0.5, elastic_weight=2.0,
                                   size_counter=0.6, stiffness_c2=0.1, m_lambda=0.3,
-                                  stiffness_c2_counter=-0.3, stiffness_c2_depth=-0.1, stiffness_c2_c2=-0.15)
+                                  stiffness_c2_counter=-0.3, stiffness_c2_depth=-0.1, stiffness_c2_c2=-0.15,
+                                  m_counter_depth=-0.7)
     synthetic = []
     for c in curves:
         m, delta_e, h_res, _ = unloading_law(c.peak, known)
