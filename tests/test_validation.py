@@ -344,3 +344,13 @@ def test_study_runs_outside_the_database(tmp_path):
     assert variant(fine, TH).mesh_density == 2.0 and variant(fine, TH).kind == "refinement"
     (de,) = load_study_files(tmp_path)
     assert variant(de, TH).strain_increment == 0.02 and de.label == "standard_de0.02"
+
+
+def test_report_reads_no_uncommitted_verification_runs_by_default():
+    """The FE verification runs (reports/fem/run_*.json, git-ignored) enter the studies only on
+    request, so the same repository gives the same report on every machine."""
+    from spherecontact.validation.__main__ import _parser
+
+    args = _parser().parse_args([])
+    assert args.studies_fallback == ""
+    assert _parser().parse_args(["--studies-fallback", "reports/fem"]).studies_fallback == "reports/fem"

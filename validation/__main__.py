@@ -28,9 +28,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="reports/validation", help="output directory")
     p.add_argument("--set", default="validation", help="database set to validate on")
     p.add_argument("--studies-set", default="studies", help="database set of the FE studies")
-    p.add_argument("--studies-fallback", default="reports/fem",
-                   help="directory of FE verification runs (run_*.json) used for the studies when "
-                        "the database has no studies set ('' to disable)")
+    p.add_argument("--studies-fallback", default="",
+                   help="directory of FE verification runs (run_*.json, e.g. reports/fem) added to the "
+                        "study runs when the database has no studies set (default: none, so that the "
+                        "report depends on the repository's files alone; verification runs are not "
+                        "committed)")
     p.add_argument("--mdr", default="data/peers/mdr.json",
                    help="stored LAMMPS mdr curves (JSON; a missing file leaves mdr out)")
     p.add_argument("--study-runs", default="reports/validation/studies",
@@ -64,6 +66,13 @@ def main(argv: list[str] | None = None) -> int:
             studies_source = (f"FE verification runs `{args.studies_fallback}/run_*.json` and study runs "
                               f"`{args.study_runs}/*.json` (the database has no `{args.studies_set}` "
                               "set)")
+        elif not studies:
+            from .fem_reports import load_study_files
+
+            studies = load_study_files(args.study_runs)
+            studies_source = (f"study runs `{args.study_runs}/*.json` (the database has no "
+                              f"`{args.studies_set}` set; `--studies-fallback reports/fem` adds the FE "
+                              "verification runs on disk)")
         records = load_records(db, args.set)
         mdr = None
         if args.mdr and Path(args.mdr).is_file():
