@@ -187,3 +187,27 @@ def test_hertz_check_figures_of_an_exact_and_a_perturbed_hertz_pair():
     assert exact["F_vs_a_max_pct"] < 1e-10 and exact["h1_over_h2_dev_pct_all"] < 1e-10
     high = _hertz({**run, "curves": {**curves, "F": 1.02 * curves["F"]}})
     assert abs(high["F_vs_a_max_pct"] - 2.0) < 1e-9 and abs(high["F_vs_a_mean_pct"] - 2.0) < 1e-9
+
+
+def test_penalty_tangent_without_the_gap_curvature_reaches_the_same_answer():
+    """The two-pass penalty contact's Newton tangent leaves out −λ ∂²g (twobody.PENALTY_GAP_CURVATURE):
+    the residual is the same, so an elastic pair on the same increments reaches the same F and
+    split; without the term the tangents stay positive definite (Cholesky throughout)."""
+    from spherecontact.fem.solver import SolverOptions
+    from spherecontact.fem.twobody import PENALTY_GAP_CURVATURE, TwoBodySolver
+
+    assert PENALTY_GAP_CURVATURE is False
+    soft, hard = Material(E=200.0, nu=0.3, sigma_y=math.inf), Material(E=600.0, nu=0.3, sigma_y=math.inf)
+    runs = {}
+    for curvature in (True, False):
+        s = TwoBodySolver(soft, 1.0, hard, 2.0, options=SolverOptions(penalty=100.0, tol=1e-8))
+        assert s.passes[0].gap_curvature is False
+        for p in s.passes:
+            p.gap_curvature = curvature
+        runs[curvature] = s.run(0.002)
+    exact, plain = runs[True], runs[False]
+    np.testing.assert_allclose(plain.h, exact.h, rtol=1e-9)  # the same increments (a sets their size)
+    on = exact.F > 0
+    np.testing.assert_allclose(plain.F[on], exact.F[on], rtol=1e-6)
+    np.testing.assert_allclose(plain.curves["h1"][on], exact.curves["h1"][on], rtol=1e-6)
+    assert plain.timings["linear_not_definite"] == 0
