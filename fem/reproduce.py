@@ -2,8 +2,8 @@
 
 Re-runs campaign cases of ``data/reference.h5`` with their stored inputs (the solver's
 numerics may have changed since: factorisation, Newton steps) and compares F and a with
-the stored curves at the stored approaches h/R ≥ 0.01 (log–log interpolation of the new
-curve): the systematic difference is the median of ln(new/stored), the largest one the
+the stored curves at the stored approaches h/R ≥ 0.01 of the loading increments (unloading
+cycles left out; log–log interpolation of the new curve): the systematic difference is the median of ln(new/stored), the largest one the
 maximum, beside the stored curve's own FE scatter (max |ln y − local quadratic| over 11
 increments). Two noisy curves may differ by up to the sum of their scatters.
 
@@ -22,7 +22,7 @@ import numpy as np
 from ..data import Database
 from ..validation.metrics import interp_loglog, scatter
 from .design import load_campaign
-from .io import run_indentation
+from .io import loading_mask, run_indentation
 
 #: one case per scene: a flat, a rigid sphere, two bodies (exact contact)
 CASES = ("flat-pp-E200-nu0.35", "rsphere2-pp-E200-nu0.3", "two-pp-E200-nu0.3-vs-sy3")
@@ -34,6 +34,15 @@ def compare(h_old, y_old, h_new, y_new, h_min: float) -> dict:
     return {"systematic": float(np.median(dev)), "max": float(np.max(np.abs(dev))),
             "stored_scatter": scatter(h_old, y_old, h_old >= h_min),
             "new_scatter": scatter(h_new, y_new, h_new >= h_min)}
+
+
+def compare_loading(old: dict, new: dict, h_min: float) -> dict:
+    """:func:`compare` of F and of a between two runs' curves on their loading increments (the
+    unloading and reloading of cycles left out, ``io.loading_mask``)."""
+    on_old, on_new = loading_mask(old), loading_mask(new)
+    h_old, h_new = np.asarray(old["h"])[on_old], np.asarray(new["h"])[on_new]
+    return {q: compare(h_old, np.asarray(old[q])[on_old], h_new, np.asarray(new[q])[on_new], h_min)
+            for q in ("F", "a")}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -53,8 +62,7 @@ def main(argv: list[str] | None = None) -> int:
         new = run_indentation(**case.run_kwargs())
         row = {"case": name, "status": new.status, "wall_s_new": new.timings["wall_s"],
                "wall_s_stored": float(stored.provenance.get("wall_s", np.nan)),
-               "F": compare(stored.h, stored.F, new.h, new.F, 0.01 * R),
-               "a": compare(stored.h, stored.a, new.h, new.a, 0.01 * R)}
+               **compare_loading(stored.curves, new.curves, 0.01 * R)}
         results.append(row)
         F = row["F"]
         print(f"{name}: F systematic {100 * F['systematic']:+.2f} %, max {100 * F['max']:.2f} % "
