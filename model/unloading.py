@@ -25,18 +25,19 @@ more conforming residual profile). The law here (``UnloadingCoefficients``):
   stiffer than one that sinks in; less so under a curved counter-surface, when deep, or with
   much pile-up: ``UnloadingCoefficients.stiffness_c2_counter``, ``_depth``, ``_c2``);
   δ_e = m₀ F_max C/s₀ with C = Σ C_i;
-* m = m₀ + (1 − w) m_Uz U z̄², m₀ = (1 − w)[(1 − U)(m_p + m_c2 ln c² + m_depth z̄ + m_λ λ) +
-  U m_counter] + w (3/2 + m_el ȳ²), each clipped to [1, 3], with the elastic weight w = min(λ, 1)^k, λ = p_m/p_Hertz(a) =
-  3πR* p_m/(4E*a) (1 at an elastic peak, → 0 as the pressure flattens), c² = a²/(2R*h) of the
-  peak, U = u/(1 + u), u = a|κ| the curvature of the contact surface (0 on a flat and between
-  equal spheres, a/R_i against a rigid sphere), and ȳ, z̄ the compliance-weighted a/R_i and
-  2h_i/R_i. m_counter ≈ 1.1: the dent a small rigid sphere leaves conforms to it and reloads
-  almost like a flat punch (m → 1); m_λ: the exponent rises with λ from the flat-punch-like
-  uniform pressure (λ → 0) towards Hertz; m_Uz < 0: a deep dent under a curved counter-surface
-  unloads flatter (towards a punch, m → 1) at the same elastic recovery δ_e, so the term is left
-  out of δ_e (``m_counter_depth``; FE peak of a perfectly plastic sphere under a rigid sphere of
-  its own radius at h/R 0.3: the best power law at the law's δ_e has m 1.07, the law without the
-  term 1.21, 3.5 % of F_max off mid-branch);
+* m = m₀ + (1 − w) m_Uz U z̄², m₀ = (1 − w)[(1 − U)(m_p + m_c2 ln c² + m_depth z̄ + m_λ λ)
+  + U m_counter] + w (3/2 + m_el ȳ²), each clipped to [1, 3], with the elastic weight
+  w = min(λ, 1)^k, λ = p_m/p_Hertz(a) = 3πR* p_m/(4E*a) (1 at an elastic peak, → 0 as the pressure
+  flattens), c² = a²/(2R*h) of the peak, U = u/(1 + u), u = a|κ| the curvature of the contact
+  surface (0 on a flat and between equal spheres, a/R_i against a rigid sphere), and ȳ, z̄ the
+  compliance-weighted a/R_i and 2h_i/R_i. m_counter ≈ 1.1: the dent a small rigid sphere
+  leaves conforms to it and reloads almost like a flat punch (m → 1); m_λ: the exponent rises
+  with λ from the flat-punch-like uniform pressure (λ → 0) towards Hertz; m_Uz < 0: a deep
+  dent under a curved counter-surface unloads flatter (towards a punch, m → 1) at the same
+  elastic recovery δ_e, so the term is left out of δ_e (``m_counter_depth``; FE peak of a
+  perfectly plastic sphere under a rigid sphere of its own radius at h/R 0.3: the best power
+  law at the law's δ_e has m 1.07, the law without the term 1.21, 3.5 % of F_max off
+  mid-branch);
 * h_res = r · max(h_max − δ_e, 0), r the onset ramp of the body further into plasticity
   (``levels.onset_ramp``: 0 in Level I, 1 once its level weight reaches ``levels.ONSET`` = 10⁻³,
   linear in ln Λ between) read at Λ_u = E'a/(ρ √(σ_Y σ_rep)), Johnson's parameter with the
