@@ -5,7 +5,8 @@ numerics may have changed since: factorisation, Newton steps) and compares F and
 the stored curves at the stored approaches h/R ≥ 0.01 of the loading increments (unloading
 cycles left out; log–log interpolation of the new curve): the systematic difference is the
 median of ln(new/stored), the largest one the maximum, beside the stored curve's own FE
-scatter (max |ln y − local quadratic| over 11 increments). Two noisy curves may differ by up to the sum of their scatters.
+scatter (max |ln y − local quadratic| over 11 increments). Two noisy curves may differ by up
+to the sum of their scatters.
 
 ``python -m spherecontact.fem.reproduce --out reports/fem`` → ``reproduce.json`` (``--cases``
 re-runs some cases and keeps the others' earlier rows).
