@@ -70,15 +70,21 @@ GAP_TOL = 1e-12
 #: pattern: 90 analyses, 11 SuperLU fallbacks, 125 s), the same 1059 iterations, F to 2e-12
 WINDOW = 1
 ZONE_GROWTH = 1.25
-#: penalty contact's Newton tangent: w k_N A ∂g ∂gᵀ alone (False) or with the gap's curvature
-#: term −λ ∂²g (True, the exact tangent). The curvature term makes about a third of the pair's
-#: tangents indefinite (no Cholesky: LDLᵀ at twice the cost) and Newton less robust; the
-#: residual, hence the converged answer, is the same. E ratio 3, equal yield, R₂ = 2R₁ to
-#: h = 0.03 (both runs side by side): exact tangent 173 increments (12 rejected), 799
-#: iterations, 257 tangents not positive definite, 90 s; without the term 85 increments (3
-#: rejected), 573 iterations, 5, 52 s; the elastic pair on the same 51 increments: F within
-#: 1.8e-7, h₁ 4.4e-8 (``ContactPass.gap_curvature``)
-PENALTY_GAP_CURVATURE = False
+#: penalty contact's Newton tangent: with the gap's curvature term −λ ∂²g (True, the exact
+#: tangent) or w k_N A ∂g ∂gᵀ alone (False); the residual, hence the converged answer, is the
+#: same either way (elastic pair on the same 51 increments: F within 1.8e-7, h₁ 4.4e-8). Without
+#: the term every tangent is positive definite (Cholesky throughout) but Newton converges only
+#: linearly: at a loose tolerance (1e-4) that paid on the E-ratio-3 pair R₂ = 2R₁ to h = 0.03
+#: (52 s against 90 s side by side: 85 increments and 573 iterations against 173 and 799), and
+#: cost on the campaign's pair E₂ = 3E₁ of equal radii on the surface band (9.5 iterations per
+#: increment against 3.8); at :data:`PENALTY_PAIR_TOL` the exact tangent is needed
+#: (``ContactPass.gap_curvature``)
+PENALTY_GAP_CURVATURE = True
+#: Newton tolerance of the two-body penalty contact, whatever looser ``SolverOptions.tol`` says:
+#: at 1e-4 the campaign's pair E₂ = 3E₁ (equal radii, surface band, penalty 100, cycles) stopped
+#: at h/R 0.17–0.18 (increments cut below dh_min, Newton diverging), with or without the
+#: curvature term; at 1e-8 (the tolerance its stored run was made with) it reaches h/R 0.3
+PENALTY_PAIR_TOL = 1e-8
 
 
 def slave_index(material1: Material, radius1: float, material2: Material, radius2: float,
@@ -615,7 +621,7 @@ class TwoBodySolver(CycleLegs):
             self._freeze(log, per_body)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            if not changed and res <= max(opt.tol, floor):
+            if not changed and res <= max(min(opt.tol, PENALTY_PAIR_TOL), floor):
                 kin0, p0 = kins[0], self.passes[0]
                 F = sum(abs(float(np.sum(lp * k.normal[1]))) for lp, k in zip(lams, kins, strict=True))
                 self.plastic_frozen_increments += log.get("plastic_frozen", False)
