@@ -26,7 +26,7 @@ dissipation of each body.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import SimpleNamespace
 from typing import NamedTuple
 
@@ -70,20 +70,14 @@ GAP_TOL = 1e-12
 #: pattern: 90 analyses, 11 SuperLU fallbacks, 125 s), the same 1059 iterations, F to 2e-12
 WINDOW = 1
 ZONE_GROWTH = 1.25
-#: penalty contact's Newton tangent: with the gap's curvature term −λ ∂²g (True, the exact
-#: tangent) or w k_N A ∂g ∂gᵀ alone (False); the residual, hence the converged answer, is the
-#: same either way (elastic pair on the same 51 increments: F within 1.8e-7, h₁ 4.4e-8). Without
-#: the term every tangent is positive definite (Cholesky throughout) but Newton converges only
-#: linearly: at a loose tolerance (1e-4) that paid on the E-ratio-3 pair R₂ = 2R₁ to h = 0.03
-#: (52 s against 90 s side by side: 85 increments and 573 iterations against 173 and 799), and
-#: cost on the campaign's pair E₂ = 3E₁ of equal radii on the surface band (9.5 iterations per
-#: increment against 3.8); at :data:`PENALTY_PAIR_TOL` the exact tangent is needed
-#: (``ContactPass.gap_curvature``)
-PENALTY_GAP_CURVATURE = True
-#: Newton tolerance of the two-body penalty contact, whatever looser ``SolverOptions.tol`` says:
-#: at 1e-4 the campaign's pair E₂ = 3E₁ (equal radii, surface band, penalty 100, cycles) stopped
-#: at h/R 0.17–0.18 (increments cut below dh_min, Newton diverging), with or without the
-#: curvature term; at 1e-8 (the tolerance its stored run was made with) it reaches h/R 0.3
+#: Newton tolerance of the two-body penalty contact, whatever looser ``SolverOptions.tol`` says
+#: (the solver's options, hence the run's recorded inputs, carry it): at 1e-4 the campaign's pair
+#: E₂ = 3E₁ (equal radii, surface band, penalty 100, cycles) stopped at h/R 0.17–0.18 (increments
+#: cut below dh_min, Newton diverging); at 1e-8 (the tolerance its stored run was made with) it
+#: reaches h/R 0.3. Its tangent keeps the gap's curvature term −λ ∂²g: without it (measured
+#: 2026-11-27) every tangent was positive definite but Newton linear, 9.5 iterations per
+#: increment on that pair against 3.8, and at 1e-8 the run had not finished after 31 min where
+#: the exact tangent took 20
 PENALTY_PAIR_TOL = 1e-8
 
 
@@ -169,8 +163,6 @@ class ContactPass:
         # outward normal of the master: up for body 2 (below), down for body 1 (above)
         self.side = 1.0 if master.mirror else -1.0
         self.area0 = surface_areas(slave.hmesh.X[:, slave.hmesh.surface])[:-1]
-        #: the penalty tangent's −λ ∂²g term (:data:`PENALTY_GAP_CURVATURE`)
-        self.gap_curvature = PENALTY_GAP_CURVATURE
 
     def _control_points(self):
         """Master node and r-sign of the 4 control points of every interval (4, n_int).
@@ -265,17 +257,13 @@ class ContactPass:
 
     def penalty_blocks(self, kin: Kinematics, k_n: float, pen, lam):
         """∂(Gᵀλ)/∂u per penetrating node as dense blocks: dofs (10, n) and values
-        (10, 10, n) = w k_N A ∂g ∂gᵀ, − λ ∂²g with ``gap_curvature`` (:meth:`penalty_tangent`
-        without the sparse sums)."""
+        (10, 10, n) = w k_N A ∂g ∂gᵀ − λ ∂²g (:meth:`penalty_tangent` without the sparse sums)."""
         rows = np.flatnonzero(pen)
         dofs, signs = self._dofs_and_signs(kin.seg, rows)
         gl = kin.grad[:, rows] * signs
-        kA = self.weight * k_n * self.area0[rows]
-        K = kA * gl[:, None, :] * gl[None, :, :]
-        if not self.gap_curvature:
-            return dofs, K
         H = gap_hessian(kin.coords[:, rows], self.side) * signs[:, None, :] * signs[None, :, :]
-        return dofs, K - lam[rows] * H
+        kA = self.weight * k_n * self.area0[rows]
+        return dofs, kA * gl[:, None, :] * gl[None, :, :] - lam[rows] * H
 
     def _reference_interval(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Reference radius of the candidates ``rows`` and the master interval under each of them
@@ -307,10 +295,9 @@ class ContactPass:
         return float(r0.max()), int(np.abs(kin.seg[rows] - seg0).max())
 
     def penalty_tangent(self, kin: Kinematics, k_n: float, pen, lam, G):
-        """∂(Gᵀλ)/∂u = w k_N Gᵀ diag(A) G, − Σ λ ∂²g over the penetrating nodes with
-        ``gap_curvature``."""
+        """∂(Gᵀλ)/∂u = w k_N Gᵀ diag(A) G − Σ λ ∂²g over the penetrating nodes."""
         K = G.T @ sp.diags(self.weight * k_n * self.area0[pen]) @ G
-        Kh = self.contact_stiffness(kin, pen, lam) if self.gap_curvature else None
+        Kh = self.contact_stiffness(kin, pen, lam)
         return K if Kh is None else K + Kh
 
 
@@ -331,6 +318,8 @@ class TwoBodySolver(CycleLegs):
             raise ValueError("both bodies of the two-body scene must be deformable (finite E)")
         self.options = options or SolverOptions()
         self.options.validate()
+        if self.options.penalty is not None and self.options.tol > PENALTY_PAIR_TOL:
+            self.options = replace(self.options, tol=PENALTY_PAIR_TOL)
         t0 = time.perf_counter()
         R_min = min(radius1, radius2)
         discs = [Discretisation(build_mesh(R, density, linear=(element == "q4"), contact_scale=R_min,
@@ -621,7 +610,7 @@ class TwoBodySolver(CycleLegs):
             self._freeze(log, per_body)
             if not np.isfinite(res) or res > 1e6:
                 raise IncrementFailed(f"Newton diverged (relative residual {res:.2e})")
-            if not changed and res <= max(min(opt.tol, PENALTY_PAIR_TOL), floor):
+            if not changed and res <= max(opt.tol, floor):
                 kin0, p0 = kins[0], self.passes[0]
                 F = sum(abs(float(np.sum(lp * k.normal[1]))) for lp, k in zip(lams, kins, strict=True))
                 self.plastic_frozen_increments += log.get("plastic_frozen", False)

@@ -189,31 +189,6 @@ def test_hertz_check_figures_of_an_exact_and_a_perturbed_hertz_pair():
     assert abs(high["F_vs_a_max_pct"] - 2.0) < 1e-9 and abs(high["F_vs_a_mean_pct"] - 2.0) < 1e-9
 
 
-def test_penalty_tangent_without_the_gap_curvature_reaches_the_same_answer():
-    """The two-pass penalty contact's Newton tangent may leave out −λ ∂²g
-    (twobody.PENALTY_GAP_CURVATURE, kept by default): the residual is the same, so an elastic
-    pair on the same increments reaches the same F and split; without the term the tangents stay
-    positive definite (Cholesky throughout)."""
-    from spherecontact.fem.solver import SolverOptions
-    from spherecontact.fem.twobody import PENALTY_GAP_CURVATURE, TwoBodySolver
-
-    assert PENALTY_GAP_CURVATURE is True
-    soft, hard = Material(E=200.0, nu=0.3, sigma_y=math.inf), Material(E=600.0, nu=0.3, sigma_y=math.inf)
-    runs = {}
-    for curvature in (True, False):
-        s = TwoBodySolver(soft, 1.0, hard, 2.0, options=SolverOptions(penalty=100.0, tol=1e-8))
-        assert s.passes[0].gap_curvature is True
-        for p in s.passes:
-            p.gap_curvature = curvature
-        runs[curvature] = s.run(0.002)
-    exact, plain = runs[True], runs[False]
-    np.testing.assert_allclose(plain.h, exact.h, rtol=1e-9)  # the same increments (a sets their size)
-    on = exact.F > 0
-    np.testing.assert_allclose(plain.F[on], exact.F[on], rtol=1e-6)
-    np.testing.assert_allclose(plain.curves["h1"][on], exact.curves["h1"][on], rtol=1e-6)
-    assert plain.timings["linear_not_definite"] == 0
-
-
 def test_penalty_pairs_converge_to_the_tighter_pair_tolerance():
     """Two-body penalty contact stops Newton at twobody.PENALTY_PAIR_TOL (1e-8) even when the
     options allow 1e-4: at 1e-4 the campaign's E₂ = 3E₁ pair stopped at h/R 0.17."""
@@ -225,6 +200,7 @@ def test_penalty_pairs_converge_to_the_tighter_pair_tolerance():
                       options=SolverOptions(penalty=100.0, tol=1e-4))
     r = s.run(0.002)
     assert r.status == "converged"
+    assert r.inputs["options"]["tol"] == PENALTY_PAIR_TOL  # the run records the tolerance it used
     finals = [res[-1] for res in r.residuals if res]
     # the first increments stop at the roundoff floor of their tiny reactions (above 1e-8)
     assert len(finals) >= 10 and max(finals[5:]) <= PENALTY_PAIR_TOL < 1e-4
