@@ -44,6 +44,11 @@ SMOOTH = {"edge_band": 0.03, "penalty": 300.0, "segment_points": 8, "penalty_sca
 CYCLES_AT = (0.001, 0.01, 0.1, 0.3)
 
 
+def linear_counts(timings: dict) -> dict:
+    """The linear solver's counts of a run's ``timings`` (``linear_*``, prefix dropped)."""
+    return {k[len("linear_"):]: v for k, v in timings.items() if k.startswith("linear_")}
+
+
 def standard_run(linear_solver: str, edge_band: float = 0.0, unload_at=None, E: float = 200.0,
                  indenter: float = math.inf, **options) -> dict:
     solver = IndentationSolver(Material(E=E, nu=0.3, sigma_y=1.0), 1.0, RigidObstacle(indenter),
@@ -63,7 +68,7 @@ def standard_run(linear_solver: str, edge_band: float = 0.0, unload_at=None, E: 
         "iterations_per_increment": round(its / t["increments"], 2),
         "ms_per_iteration": round(1e3 * t["wall_s"] / its, 1),
         "ms_per_iteration_split": {k: round(1e3 * t[f"{k}_s"] / its, 2) for k in PHASES},
-        "linear": {k[len("linear_"):]: v for k, v in t.items() if k.startswith("linear_")},
+        "linear": linear_counts(t),
         "F_end": float(res.F[-1]),
         "a_end": float(res.a[-1]),
         "scatter_F": round(scatter(res.h[late], res.F[late]), 5),
@@ -87,7 +92,7 @@ def pair_run() -> dict:
             "status": res.status, "n_dofs": solver.n_dofs, "wall_s": round(t["wall_s"], 2),
             "increments": t["increments"], "newton_iterations": t["newton_iterations"],
             "rejected_increments": t["rejected_increments"],
-            "linear": {k[len("linear_"):]: v for k, v in t.items() if k.startswith("linear_")},
+            "linear": linear_counts(t),
             "F_end": float(res.F[-1]), "body1_flat_wall_s": round(flat["wall_s"], 2),
             "wall_over_body1_flat": round(t["wall_s"] / flat["wall_s"], 2),
             "target_wall_over_body1_flat": 3.0}
