@@ -14,7 +14,9 @@ pressed by a rigid flat or sphere (EPP, ν = 0.3):
   obstacle presses in by about h/P, so an edge that closes takes its pressure over that
   penetration instead of at once; F is read against the body's own shortening.
 
-``--only i j …`` runs those cases and keeps the other cases' earlier figures.
+``--only i j …`` runs those cases and keeps the other cases' earlier figures. Each record
+carries the date, the Newton tolerance and the predictor it was measured with: at E/σY 10⁴ the
+scatter moves with them (README, "Smoothness of F").
 
 Writes ``smoothness.json`` and ``smoothness.png`` (scatter of F against wall time).
 ``python -m spherecontact.fem.smoothness --out reports/fem`` (~30 min on one core).
@@ -25,6 +27,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -57,6 +60,14 @@ CASES = [
     ("flat E10000, band 0.02, approach penalty 300", 10000.0, math.inf, 0.02, APPROACH),
     ("flat E10000, band 0.03, approach penalty 100", 10000.0, math.inf, 0.03,
      {**APPROACH, "penalty": 100.0}),
+    ("flat E10000, band 0.02, approach penalty 100", 10000.0, math.inf, 0.02,
+     {**APPROACH, "penalty": 100.0}),
+    ("flat E10000, band 0.015, approach penalty 300", 10000.0, math.inf, 0.015, APPROACH),
+    ("flat E1000, band 0.02, approach penalty 300", 1000.0, math.inf, 0.02, APPROACH),
+    ("flat E10000, band 0.02, approach penalty 300, Newton 1e-8", 10000.0, math.inf, 0.02,
+     {**APPROACH, "tol": 1e-8}),
+    ("flat E10000, band 0.02, approach penalty 300, Newton 1e-8, secant predictor", 10000.0,
+     math.inf, 0.02, {**APPROACH, "tol": 1e-8, "predictor": "secant"}),
 ]
 BANDS = ((0.01, 0.03), (0.03, 0.1), (0.1, 0.3), (0.3, 1.2))
 
@@ -73,7 +84,9 @@ def measure(E: float, indenter: float, band: float, options: dict, h_max: float 
         sel = m & (a >= lo) & (a < hi)
         by_band[f"{lo:g}-{hi:g}"] = scatter(h[sel], F[sel]) if sel.sum() >= 11 else None
     t = res.timings
-    return {"status": res.status, "n_dofs": solver.disc.n_dofs, "wall_s": t["wall_s"],
+    return {"date_utc": datetime.now(UTC).strftime("%Y-%m-%d"), "newton_tol": solver.options.tol,
+            "predictor": solver.options.predictor, "status": res.status, "n_dofs": solver.disc.n_dofs,
+            "wall_s": t["wall_s"],
             "increments": t["increments"], "newton_iterations": t["newton_iterations"],
             "scatter_F": scatter(h, F, m), "scatter_a": scatter(h, a, m),
             "scatter_F_by_a_band": by_band, "F_end": float(F[-1]), "a_end": float(a[-1])}
