@@ -19,7 +19,7 @@ carries the date, the Newton tolerance and the predictor it was measured with: a
 scatter moves with them (README, "Smoothness of F").
 
 Writes ``smoothness.json`` and ``smoothness.png`` (scatter of F against wall time).
-``python -m spherecontact.fem.smoothness --out reports/fem`` (~30 min on one core).
+``python -m spherecontact.fem.smoothness --out reports/fem`` (~85 min on one core).
 """
 
 from __future__ import annotations
