@@ -26,7 +26,12 @@ staircase over about two nodes of the surface mesh.
 Resolution filter: the pole zone of the FE mesh has elements of 0.003 R/density.
 The sub-element contact radius is within 0.5 % of Hertz (both p_m and c², elastic
 run of the FE verification) from a ≈ 0.02 R on, i.e. about seven pole elements, and
-off by 1–5 % below; points with a < ``A_MIN_ELEMENTS`` pole elements are dropped.
+off by 1–5 % below; points with a < ``A_MIN_ELEMENTS`` pole elements are dropped. Runs on
+the surface-band mesh (``edge_band`` > 0, every run of campaign v2) have surface elements of
+0.0005 R at the pole, 20 across a = 0.01 R: their points count from ``A_MIN_BAND_ELEMENTS``
+pole elements (a ≥ 0.01 R at density 1), where the validation window starts
+(``validation/thresholds.toml``). There, the stored start of the EPP E/σY 2500 validation run
+is within 0.6 % in F of a re-run on the default mesh at twice its density (a/R 0.0106).
 """
 
 from __future__ import annotations
@@ -43,6 +48,7 @@ from ..model.single import representative_strain, representative_stress
 
 __all__ = [
     "A_MIN_ELEMENTS",
+    "A_MIN_BAND_ELEMENTS",
     "POLE_ELEMENT",
     "PER_DECADE",
     "RunCurve",
@@ -59,6 +65,8 @@ __all__ = [
 POLE_ELEMENT = 0.003
 #: smallest usable contact radius, in pole elements (a ≥ 0.02 R at density 1)
 A_MIN_ELEMENTS = 20.0 / 3.0
+#: ... for runs on the surface-band mesh (a ≥ 0.01 R at density 1)
+A_MIN_BAND_ELEMENTS = 10.0 / 3.0
 #: grid nodes per decade of h
 PER_DECADE = 16
 
@@ -137,10 +145,12 @@ class RunCurve:
 
 
 def run_curve(key: str, run, per_decade: int = PER_DECADE,
-              a_min_elements: float = A_MIN_ELEMENTS) -> RunCurve | None:
+              a_min_elements: float = A_MIN_ELEMENTS,
+              a_min_band_elements: float = A_MIN_BAND_ELEMENTS) -> RunCurve | None:
     """Resample one run's loading curve (a ``spherecontact.fem.io.Run`` or anything with
     ``h, F, a, inputs, material()`` and optionally a ``loading`` mask); None if no
-    increment is resolved (a < a_min).
+    increment is resolved (a < a_min: ``a_min_band_elements`` pole elements on the
+    surface-band mesh, ``a_min_elements`` otherwise).
     """
     inp = run.inputs
     R = float(inp["radius"])
@@ -157,7 +167,8 @@ def run_curve(key: str, run, per_decade: int = PER_DECADE,
     h, F, a = h[ok], F[ok], a[ok]
     order = np.argsort(h, kind="stable")
     h, F, a = h[order], F[order], a[order]
-    a_min = a_min_elements * POLE_ELEMENT * R / density
+    band = float(inp.get("edge_band", 0.0) or 0.0) > 0.0
+    a_min = (a_min_band_elements if band else a_min_elements) * POLE_ELEMENT * R / density
     use = a >= a_min
     if np.count_nonzero(use) < 2:
         return None
@@ -262,12 +273,13 @@ def _log_slope(h: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def build_dataset(runs: Iterable[tuple[str, object]], per_decade: int = PER_DECADE,
-                  a_min_elements: float = A_MIN_ELEMENTS, elastic_sphere: tuple = ()) -> Dataset:
+                  a_min_elements: float = A_MIN_ELEMENTS, elastic_sphere: tuple = (),
+                  a_min_band_elements: float = A_MIN_BAND_ELEMENTS) -> Dataset:
     """Dataset of ``(key, run)`` pairs; runs without resolved points are skipped.
     ``elastic_sphere``: the Level I anchor points (``Dataset.elastic_sphere``)."""
     curves = []
     for key, run in runs:
-        c = run_curve(key, run, per_decade, a_min_elements)
+        c = run_curve(key, run, per_decade, a_min_elements, a_min_band_elements)
         if c is not None:
             curves.append(c)
     return dataclasses.replace(build_dataset_from_curves(curves), elastic_sphere=tuple(elastic_sphere))

@@ -19,7 +19,10 @@ out here, so a column costs a few array operations instead of an evaluation of t
 
 β and γ move σ_rep = σ_f(ε_rep) by m d ln ε_rep (m: the flow curve's log slope) and Λ by the
 opposite, which acts through d ln H̄_hs/d ln Λ and d ln c²_hs/d ln Λ (the level functions' slopes
-and the level weight of the finite-size factors); ln Λ_I and L = ln(Λ_III/Λ_I) move
+and the level weight of the finite-size factors; with the exponent read along the curve,
+``local_secant``, they move n as well, by (dn/d ln ε_rep) d ln ε_rep, which acts through
+∂ln p_m/∂n and ∂ln c²/∂n: the half-space values' by a forward step in n, the collapse limits'
+written out, ``CollapseLimit.dlog_dn``); ln Λ_I and L = ln(Λ_III/Λ_I) move
 t = (ln Λ − ln Λ_I)/L and H̄_I = 4Λ_I/(3π) (``_Parts.level_bounds``). A parameter not named
 here would get forward differences of the whole residual (scipy's '2-point' step rule). The
 penalty rows get forward differences for every parameter they depend on, those of a penalty
@@ -36,7 +39,8 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import Coefficients
-from .forms import X_C2, counter_surface_at, flow_log_slope_at, point_inputs
+from ..model.single import N_STEP as _N_STEP
+from .forms import X_C2, counter_surface_at, exponent_slope_at, flow_log_slope_at, point_inputs
 
 __all__ = ["residual_jacobian"]
 
@@ -116,9 +120,18 @@ class _Parts:
         self.pos = pos = (H_hs > 0.0) & ~elastic
         zero = np.zeros_like(H_hs)
         one = np.ones_like(H_hs)
+        if co.exponent_local:  # ∂ln H̄_q/∂n, ∂ln c²_q/∂n by a forward step (n-terms: polynomials)
+            self.dn = exponent_slope_at(ds, co)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                self.Hq_n = np.where(pos, (np.log(levels.H_bar_and_slope(Lam, co, n + _N_STEP)[0])
+                                           - np.log(H_q)) / _N_STEP, 0.0)
+                self.cq_n = np.where(pos, (np.log(levels.c2_and_slope(Lam, co, n + _N_STEP)[0])
+                                           - np.log(c_q)) / _N_STEP, 0.0)
         if not co.has_collapse:
             self.A, self.B, self.CcH, self.Ccc = one, zero, zero, one
             self.dH_dlnk = self.dc_dlnk = self.dc_dlnkc = self.dc_ds = zero
+            if co.exponent_local:
+                self.p_n, self.c_n = self.Hq_n, self.cq_n
             return
         lnHc = co.collapse_H_bar.log_and_slope(y, n, z)[0]
         lncc = co.collapse_c2.log_and_slope(y, n, z)[0]
@@ -140,6 +153,12 @@ class _Parts:
         self.dc_dlnkc = gap * dwc * (lnr + s_c) * kc
         self.dc_dlnk = self.dc_dlnkc if k_c is None else zero
         self.dc_ds = gap * kc * dwc
+        if co.exponent_local:  # ∂ln p_m/∂n, ∂ln c²/∂n through both halves of the blend
+            Hc_n = co.collapse_H_bar.dlog_dn(y, n, z)
+            cc_n = co.collapse_c2.dlog_dn(y, n, z)
+            self.p_n = np.where(pos, self.A * self.Hq_n + self.B * Hc_n, 0.0)
+            self.c_n = np.where(pos, self.CcH * (self.Hq_n - Hc_n) + self.Ccc * self.cq_n
+                                + (1.0 - self.Ccc) * cc_n, 0.0)
 
     def _shape_sum(self, b, bn=()):
         """S(t) of the Level II shape (``levels._shape`` without the slope term m₀) and the
@@ -211,13 +230,19 @@ class _Parts:
                 gc = np.where(self.lev2, -t * self.sc, 0.0) - t * self.lfc
         return np.where(self.pos, gH, 0.0), np.where(self.pos, gc, 0.0)
 
+    def exponent_move(self, name: str):
+        """dn/dθ for θ = β or γ of the exponent read along the curve: (dn/d ln ε_rep) d ln ε_rep/dθ."""
+        return np.where(self.pos, self.dn * self._dln_eps(name), 0.0)
+
+    def _dln_eps(self, name: str):
+        x = self.x_rho
+        return 1.0 / self.beta if name == "beta" else x / (1.0 + self.growth * x)
+
     def strain(self, name: str):
         """d ln σ_rep/dθ for θ = β or γ of ε_rep = β x (1 + γ x): m d ln ε_rep/dθ, with m the
         flow curve's log slope at ε_rep (``single.flow_log_slope``); Λ = E'x/σ_rep moves by
         −d ln σ_rep."""
-        x = self.x_rho
-        dln_eps = 1.0 / self.beta if name == "beta" else x / (1.0 + self.growth * x)
-        return np.where(self.pos, self.m * dln_eps, 0.0)
+        return np.where(self.pos, self.m * self._dln_eps(name), 0.0)
 
     def _finite(self, elastic_coefficient: bool, f, k: int):
         """d ln f/d e_k (Level I coefficient) or d ln f/d q_k (Level III); both when tied."""
@@ -257,10 +282,15 @@ def _log_derivatives(parts: _Parts, name: str, co: Coefficients):
     if name in ("ln_Lambda_I", "ln_Lambda_III_over_I"):
         gH, gc = parts.level_bounds(name)
         return parts.A * gH, parts.CcH * gH + parts.Ccc * gc
-    if name in ("beta", "beta_growth"):  # σ_rep moves, Λ by −d ln σ_rep
+    if name in ("beta", "beta_growth"):  # σ_rep moves, Λ by −d ln σ_rep (and n along the curve)
         dsig = parts.strain(name)
         gH, gc = parts.sH + parts.lfH, parts.sc + parts.lfc
-        return dsig * (1.0 - parts.A * gH), -dsig * (parts.CcH * gH + parts.Ccc * gc)
+        dp, dc = dsig * (1.0 - parts.A * gH), -dsig * (parts.CcH * gH + parts.Ccc * gc)
+        if co.exponent_local:
+            dn = parts.exponent_move(name)
+            dp = dp + dn * parts.p_n
+            dc = dc + dn * parts.c_n
+        return dp, dc
     if name in ("counter_H", "counter_H3"):  # ln H̄_hs (and the Hertz p_m of elastic points)
         # move by s(u), by the level weight's share when the terms depend on the level
         lev = parts.s if name == "counter_H3" else (1.0 - parts.s if co.counter_H_bar_plastic is not None

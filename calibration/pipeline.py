@@ -416,7 +416,7 @@ def coefficient_file(cal: Calibration) -> dict:
             "materials": len(ds.groups),
             "points": ds.size,
             "filter": f"a >= {ds.curves[0].a_min / ds.curves[0].radius:g} R at mesh density 1 "
-                      "(20/3 pole elements)",
+                      "(20/3 pole elements of the default mesh, 10/3 on the surface-band mesh)",
         },
         "fit_residuals": {q: _stats(e) for q, e in best.errors.items()},
         "noise_floor": {"H_bar": _stat(cal.noise["H_bar"]), "c2": _stat(cal.noise["c2"]),

@@ -247,9 +247,11 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
              f"(each run resampled on a fixed grid of {16} points per decade of h; local linear "
              "fit in ln–ln over ±1 grid step, which averages the force staircase of the surface mesh)")
     a_min = ds.curves[0].a_min / ds.curves[0].radius
-    L.append(f"* resolution filter a ≥ {a_min:g} R (20/3 pole elements of the default mesh): in the "
-             "elastic verification run the sub-element contact radius reproduces Hertz's p_m and c² "
-             "to within 0.5 % from a = 0.02 R on and is off by 1–5 % below it")
+    L.append(f"* resolution filter a ≥ {a_min:g} R: on the default mesh 20/3 pole elements (0.02 R; in "
+             "the elastic verification run the sub-element contact radius reproduces Hertz's p_m and c² "
+             "to within 0.5 % from a = 0.02 R on and is off by 1–5 % below it), on the surface-band mesh "
+             "of campaign v2 0.01 R, where the validation window starts (20 band elements across a; "
+             "`calibration/dataset.py`)")
     if src.get("partial"):
         L.append("* stopped before h_max, their converged increments used: " + ", ".join(
             f"{x['case']} (to h/R = {x['h_last']:.3g}: {x['reason']})" for x in src["partial"]))

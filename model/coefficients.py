@@ -49,6 +49,12 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   curve averaged over a log-normal distribution of strains about ε_rep,
   σ_rep = ⅔ σ_f(ε_rep) + ⅙ σ_f(ε_rep e^(−√3W)) + ⅙ σ_f(ε_rep e^(√3W)) (three-point
   Gauss–Hermite), ``single.representative_stress``; W = 0 is σ_rep = σ_f(ε_rep);
+* hardening exponent (``hardening_exponent``): ``secant_loglog``, one n per material, the secant
+  of ln σ_rep against ln ε between ``eps_lo`` and ``eps_hi``; or ``local_secant`` (keys ``window``
+  K and ``cap`` c as well), n read along the curve at each contact radius, the secant over
+  [ε_rep/K, K ε_rep] softly capped, n/(1 + (n/c)⁴)^¼ (``single.local_exponent``): a curve that is
+  not a power law (saturating, linear) has the exponent of the strains the contact holds. The
+  calibrated range's exponent axis stays the per-material secant;
 * unloading (optional ``unloading``; absent: Thornton 1997, Hertz from the peak): the
   elastic unloading branch below the largest approach reached, F = F_max ξ^m
   (``unloading.py`` gives the law; :class:`UnloadingCoefficients` the keys).
@@ -100,7 +106,10 @@ RATIOS = ("a_over_rho", "a_over_R")
 #: variables of the collapse limits' z-polynomials (``collapse.z_variable``): z itself, or
 #: ln(1 + max(z, 0)) = ln(R/ρ_c) (0 for z ≤ 0, where no calibration run lies)
 Z_VARIABLES = ("z", "ln(1+z)")
-EXPONENT_METHODS = ("secant_loglog",)
+EXPONENT_METHODS = ("secant_loglog", "local_secant")
+#: allowed ranges of the ``local_secant`` exponent's window factor and cap
+EXPONENT_WINDOW_RANGE = (1.5, 10.0)
+EXPONENT_CAP_RANGE = (0.1, 2.0)
 
 #: Built-in literature set (schema 1): the starting values of calibration and the fallback
 #: when ``data/coefficients.json`` is missing.
@@ -508,6 +517,22 @@ class CollapseLimit:
             lnL = math.log(self.prefactor) - power + s + sz + np.log(_exp_poly(1.0, self.exp_poly, n))
         return lnL, ds - self.exponent, dz
 
+    def dlog_dn(self, x, n=0.0, z=0.0, x_max: float | None = None, z_max: float | None = None):
+        """∂ln L/∂n at x, n, z (vectorised; the same continuations as :meth:`log_and_slope`):
+        Σ (k+1) exp_poly[k] n^k + Σ xn_poly[k] x^(k+1) + Σ zn_poly[k] z^(k+1)."""
+        x = np.asarray(x, dtype=float)
+        n_ = np.asarray(n, dtype=float)
+        d = np.zeros(np.broadcast_shapes(x.shape, n_.shape, np.shape(z)))
+        for k in range(len(self.exp_poly) - 1, -1, -1):  # d/dn Σ c_k n^(k+1)
+            d = d * n_ + (k + 1) * self.exp_poly[k]
+        if self.xn_poly:
+            xc, u = continue_beyond(x, x_max)
+            sn, dsn = _poly_and_slope(xc, self.xn_poly)
+            d = d + (sn + dsn * (1.0 - u) if x_max is not None else sn)
+        if self.zn_poly:
+            d = d + _z_terms(np.asarray(z, dtype=float), z_max, self.zn_poly)[0]
+        return d
+
     def __call__(self, x, n=0.0, z=0.0):
         return np.exp(self.log_and_slope(x, n, z)[0])
 
@@ -562,6 +587,10 @@ class Coefficients:
     #: W, log-width of the strains the representative stress averages the flow curve over
     #: (``single.representative_stress``); 0: σ_rep = σ_f(ε_rep)
     strain_spread: float = 0.0
+    #: ``local_secant`` exponent: window factor K (the secant of σ_rep over [ε_rep/K, K ε_rep]) and
+    #: cap c (n/(1 + (n/c)⁴)^¼); 0 for ``secant_loglog``
+    exponent_window: float = 0.0
+    exponent_cap: float = 0.0
     #: Level II shape terms per unit of the effective hardening exponent (``level_II.H_bar_shape_n``,
     #: ``c2_shape_n``; empty: none): P(t) = Σ (b_k + bn_k n) t^k
     H_bar_shape_n: tuple[float, ...] = ()
@@ -641,6 +670,15 @@ class Coefficients:
                 "coefficients: need 0 < 'hardening_exponent.eps_lo' < 'hardening_exponent.eps_hi',"
                 f" got {eps_lo!r}, {eps_hi!r}"
             )
+        window = cap = 0.0
+        if method == "local_secant":
+            window = _number(hexp, "window", "hardening_exponent.")
+            cap = _number(hexp, "cap", "hardening_exponent.")
+            for name, v, (lo, hi) in (("window", window, EXPONENT_WINDOW_RANGE),
+                                      ("cap", cap, EXPONENT_CAP_RANGE)):
+                if not lo <= v <= hi:
+                    raise ValueError(f"coefficients: 'hardening_exponent.{name}' must lie in "
+                                     f"[{lo:g}, {hi:g}], got {v!r}")
         fs = _section(d, "finite_size")
         refs = d.get("references", {})
         if not isinstance(refs, dict):
@@ -708,6 +746,8 @@ class Coefficients:
             exponent_method=method,
             eps_lo=eps_lo,
             eps_hi=eps_hi,
+            exponent_window=window,
+            exponent_cap=cap,
             finite_size_ratio=_choice(fs, "ratio", "finite_size.", RATIOS),
             finite_size_H_bar=_poly(fs, "H_bar", "finite_size."),
             finite_size_c2=_poly(fs, "c2", "finite_size."),
@@ -754,7 +794,9 @@ class Coefficients:
             "c2_III": {"prefactor": self.c2_III_prefactor, "exp_poly": list(self.c2_III_exp_poly)},
             "level_II": {"H_bar_shape": list(self.H_bar_shape), "c2_shape": list(self.c2_shape)},
             "hardening_exponent": {"method": self.exponent_method, "eps_lo": self.eps_lo,
-                                   "eps_hi": self.eps_hi},
+                                   "eps_hi": self.eps_hi,
+                                   **({"window": self.exponent_window, "cap": self.exponent_cap}
+                                      if self.exponent_local else {})},
             "finite_size": {"ratio": self.finite_size_ratio, "H_bar": list(self.finite_size_H_bar),
                             "c2": list(self.finite_size_c2)},
         }
@@ -831,6 +873,12 @@ class Coefficients:
     def H_bar_I(self) -> float:
         """H̄ at the end of Level I: 4Λ_I/(3π) (Hertz)."""
         return 4.0 * self.Lambda_I / (3.0 * math.pi)
+
+    @property
+    def exponent_local(self) -> bool:
+        """True when the hardening exponent is read along the flow curve (``local_secant``,
+        ``single.local_exponent``) instead of once per material (``secant_loglog``)."""
+        return self.exponent_method == "local_secant"
 
     def H_bar_III(self, n):
         """Level III normalised hardness H̄_III(n), n = effective hardening exponent."""

@@ -316,6 +316,11 @@ def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
         return H, c2_hs * np.exp(wc * gap), w, gap, wc
 
 
+def blend_pressure(H_hs, lnHc, k: float):
+    """The H̄ half of :func:`blend_from_logs`: H̄, w and ln r = ln H_hs − ln H̄_c."""
+    return _blend_H(H_hs, lnHc, k)
+
+
 def _blend_H(H_hs, lnHc, k: float):
     """The H̄ half of :func:`blend_from_logs`: H̄, w and ln r = ln H_hs − ln H̄_c."""
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):

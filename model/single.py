@@ -49,10 +49,14 @@ import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
 from .levels import (
+    H_bar_and_slope,
+    blend_pressure,
+    c2_and_slope,
     collapse_blend,
     collapse_pressure,
     counter_surface,
     finite_size_by_level,
+    level,
     level_t,
     level_weight,
     levels_scalar_n,
@@ -70,6 +74,8 @@ __all__ = [
     "curvature_ratio",
     "flow_log_slope",
     "effective_exponent",
+    "local_exponent",
+    "capped_exponent",
     "hardening_magnitude",
     "BodyResponse",
     "BodyLaw",
@@ -186,6 +192,36 @@ def effective_exponent(material: Material, coeffs: Coefficients) -> float:
     return float(math.log(s_hi / s_lo) / math.log(coeffs.eps_hi / coeffs.eps_lo))
 
 
+def local_exponent(material: Material, eps, coeffs: Coefficients):
+    """Hardening exponent read along the flow curve (``local_secant``) and d n/d ln ε at ε_rep
+    = ``eps`` (vectorised): the secant n₀ = ln(σ_rep(Kε)/σ_rep(ε/K))/ln K² of the averaged curve
+    (:func:`representative_stress`), capped softly, n = n₀/(1 + (n₀/c)⁴)^¼ (K =
+    ``coeffs.exponent_window``, c = ``coeffs.exponent_cap``); dn/dn₀ = (1 + (n₀/c)⁴)^(−5/4).
+    Exact for σ_f = K εⁿ below the cap. Without the cap linear hardening reads n → 1 at large
+    strain, where c²_III(n) falls, and F(h) turned non-monotone (d ln h/d ln a down to −0.35)."""
+    eps = np.asarray(eps, dtype=float)
+    if material.is_rigid or math.isinf(material.sigma_y):
+        zero = np.zeros_like(eps)
+        return zero, zero
+    K, e = coeffs.exponent_window, eps.ravel()
+    sig, m = representative_stress(material, np.concatenate([e / K, e * K]), coeffs.strain_spread)
+    k, span = e.size, 2.0 * math.log(K)
+    n, dn_dn0 = capped_exponent(np.log(sig[k:] / sig[:k]).reshape(eps.shape) / span, coeffs.exponent_cap)
+    return n, dn_dn0 * (m[k:] - m[:k]).reshape(eps.shape) / span
+
+
+def capped_exponent(n0, cap: float):
+    """n = n₀/(1 + (n₀/c)⁴)^¼ and dn/dn₀ = (1 + (n₀/c)⁴)^(−5/4), c = ``cap``
+    (:func:`local_exponent`)."""
+    q = 1.0 + (np.asarray(n0, dtype=float) / cap) ** 4
+    return n0 * q ** -0.25, q ** -1.25
+
+
+#: step of the forward differences in n of the level functions and collapse limits (``BodyLaw``
+#: with a ``local_secant`` exponent): their n-terms are polynomials and exponentials of n
+N_STEP = 1e-6
+
+
 def hardening_magnitude(material: Material, coeffs: Coefficients) -> float:
     """Hardening magnitude K/σ_Y of a flow curve (the calibrated-range axis next to n).
 
@@ -206,16 +242,25 @@ def hardening_magnitude(material: Material, coeffs: Coefficients) -> float:
     return float(d_hi / coeffs.eps_hi ** min(max(n_l, 0.0), 1.0) / s0)
 
 
-def _segment(material: Material, eps, spread: float = 0.0) -> np.ndarray:
+def _segment(material: Material, eps, spread: float = 0.0, window: float = 0.0) -> np.ndarray:
     """Index of the flow-curve piece containing ε (0 for Ludwik curves); with a strain spread,
-    one index for the pieces of all the strains σ_rep reads (:func:`representative_stress`)."""
+    one index for the pieces of all the strains σ_rep reads (:func:`representative_stress`); with
+    a ``window`` K > 0 (the exponent read along the curve, :func:`local_exponent`) the pieces of
+    the strains ε/K and Kε it reads as well, added as a sum: every index grows with ε, so the sum
+    changes wherever one of them does and never comes back to a value."""
     if not material.is_tabulated:
         return np.zeros(np.shape(eps), dtype=np.int64)
     et = np.asarray(material.eps_table)
+    eps = np.asarray(eps)
     idx = np.zeros(np.shape(eps), dtype=np.int64)
-    for f, _ in spread_factors(spread):
-        seg = np.clip(np.searchsorted(et, f * np.asarray(eps), side="right") - 1, 0, et.size - 2)
+    factors = spread_factors(spread)
+    for f, _ in factors:
+        seg = np.clip(np.searchsorted(et, f * eps, side="right") - 1, 0, et.size - 2)
         idx = idx * (et.size - 1) + seg
+    if window > 0.0:
+        moved = sum(np.clip(np.searchsorted(et, f * g * eps, side="right") - 1, 0, et.size - 2)
+                    for f, _ in factors for g in (1.0 / window, window))
+        idx = idx + (et.size - 1) ** len(factors) * moved
     return idx
 
 
@@ -273,7 +318,12 @@ class BodyLaw:
         sig, m = representative_stress(mat, eps, co.strain_spread)
         m = m * g
         s, ds = level_weight(mat.E_prime * x / sig, co)
-        return s, ds * (1.0 - m), self.H_bar_III * sig, m
+        if not co.exponent_local:
+            return s, ds * (1.0 - m), self.H_bar_III * sig, m
+        n, dn = local_exponent(mat, eps, co)
+        H3 = co.H_bar_III(n)
+        dlnH3 = (np.log(co.H_bar_III(n + N_STEP)) - np.log(H3)) / N_STEP
+        return s, ds * (1.0 - m), H3 * sig, m + dlnH3 * dn * g
 
     def _piece(self, Lam, eps, y, x) -> np.ndarray:
         """Smooth-piece id from the level of Λ (``levels.stage``), the stage of the unloading
@@ -281,7 +331,7 @@ class BodyLaw:
         (beyond x_fit_max)."""
         mat, co = self.material, self.coeffs
         piece = (stage(Lam, co) + 3 * onset_stage(self.onset_Lambda(x, Lam), co)
-                 + 9 * _segment(mat, eps, co.strain_spread))
+                 + 9 * _segment(mat, eps, co.strain_spread, co.exponent_window))
         if self.continued:  # the fitted terms are continued beyond x_fit_max: C¹, not C²
             piece = 2 * piece + (y > self.x_fit_max)
         return piece
@@ -337,7 +387,15 @@ class BodyLaw:
             m = m * g  # d ln σ_rep/d ln x
         with_c2 = not pressure_only
         t = level_t(Lam, co)
-        H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III, self.n_eff, t, with_c2)
+        local = co.exponent_local and not math.isinf(mat.sigma_y)
+        if local:  # n(x) along the curve: its slope n_x = dn/d ln x enters every n-term
+            n, n_x = local_exponent(mat, eps, co)
+            n_x = n_x * g
+            H, sH, H_n, c, sc, c_n = _levels_and_n_slopes(Lam, co, n, with_c2)
+            lev = level(Lam, co)
+        else:
+            n = self.n_eff
+            H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III, n, t, with_c2)
         with np.errstate(invalid="ignore"):
             p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
         s_l, ds_l = level_weight(Lam, co, t)
@@ -345,12 +403,16 @@ class BodyLaw:
         fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
         p = p * fH
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
+        if local:
+            dp_x = dp_x + H_n * n_x
         piece = dc_x = dc_y = None
         if with_c2:
             fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
             piece = self._piece(Lam, eps, y, x)
             c = c * fc
             dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
+            if local:
+                dc_x = dc_x + c_n * n_x
         if co.has_counter_surface:  # exp(q s(u)), u = x − y (``levels.counter_surface``)
             if xc is None:
                 su, su_x, su_y = counter_surface(x, y)
@@ -366,6 +428,9 @@ class BodyLaw:
             if with_c2:
                 c = c * np.exp(qc * su)
                 dc_x, dc_y = dc_x + qc * su_x + dqc * su * lev_x, dc_y + qc * su_y + dqc * su * lev_y
+        if co.has_collapse and local:
+            return self._collapse_local(p, sig, m, c, y, n, n_x, z, Lam, piece,
+                                        (dp_x, dp_y), (dc_x, dc_y))
         if co.has_collapse and not math.isinf(mat.sigma_y):
             if not with_c2:
                 Hb, w, dlnHc = collapse_pressure(p / sig, y, co, self.n_eff, z)
@@ -387,6 +452,47 @@ class BodyLaw:
             dlnp_dlnx=dp_x, dlnp_dlny=dp_y,
             dlnc2_dlnx=dc_x, dlnc2_dlny=dc_y, piece=piece,
         )
+
+
+    def _collapse_local(self, p, sig, m, c, y, n, n_x, z, Lam, piece, dp, dc) -> BodyResponse:
+        """The collapse blend of :meth:`response` with n read along the curve: the limits'
+        n-terms move with x, ∂ln H̄_c/∂ln x += (∂ln H̄_c/∂n) n_x (likewise c²_c), in the x slot."""
+        co = self.coeffs
+        zv, zm, xm = co.collapse_z(z), co.collapse_z(co.z_fit_max), co.x_fit_max
+        Hc_n = co.collapse_H_bar.dlog_dn(y, n, zv, xm, zm)
+        (dp_x, dp_y), (dc_x, dc_y) = dp, dc
+        if c is None:  # pressure only: the H̄ half of the blend (``levels.collapse_pressure``)
+            lnHc, dlnHc = co.collapse_H_bar.log_and_slope(y, n, zv, xm, zm)[:2]
+            Hb, w, _ = blend_pressure(p / sig, lnHc, co.collapse_sharpness)
+            return BodyResponse(p_m=Hb * sig, c2=None, Lambda=Lam, sigma_rep=sig,
+                                dlnp_dlnx=(1.0 - w) * dp_x + w * (m + Hc_n * n_x),
+                                dlnp_dlny=(1.0 - w) * dp_y + w * dlnHc,
+                                dlnc2_dlnx=None, dlnc2_dlny=None, piece=None)
+        b = collapse_blend(p / sig, c, y, co, n, z)
+        w, wc = b.w, b.w_c2
+        dr_x, dr_y = dp_x - m - Hc_n * n_x, dp_y - b.dlnHc_dlnx  # ∂ln r
+        p_m = b.H_bar * sig
+        dp_x, dp_y = (1.0 - w) * dp_x + w * (m + Hc_n * n_x), (1.0 - w) * dp_y + w * b.dlnHc_dlnx
+        cc_n = co.collapse_c2.dlog_dn(y, n, zv, xm, zm)
+        v = co.c2_sharpness * wc * (1.0 - wc) * b.lnc2_gap
+        dc_x = (1.0 - wc) * dc_x + wc * cc_n * n_x + v * dr_x
+        dc_y = (1.0 - wc) * dc_y + wc * b.dlnc2c_dlnx + v * dr_y
+        return BodyResponse(p_m=p_m, c2=b.c2, Lambda=Lam, sigma_rep=sig, dlnp_dlnx=dp_x,
+                            dlnp_dlny=dp_y, dlnc2_dlnx=dc_x, dlnc2_dlny=dc_y, piece=piece)
+
+
+def _levels_and_n_slopes(Lam, co: Coefficients, n, with_c2: bool):
+    """H̄, d ln H̄/d ln Λ, ∂ln H̄/∂n and (with ``with_c2``) the same three of c² at per-point n
+    (``levels.H_bar_and_slope``, ``levels.c2_and_slope``; ∂/∂n by a forward step)."""
+    H, sH = H_bar_and_slope(Lam, co, n)
+    with np.errstate(divide="ignore", invalid="ignore"):  # H̄ = 0 at x = 0: no n-slope
+        H_n = np.where(H > 0.0, (np.log(H_bar_and_slope(Lam, co, n + N_STEP)[0]) - np.log(H))
+                       / N_STEP, 0.0)
+    if not with_c2:
+        return H, sH, H_n, None, None, None
+    c, sc = c2_and_slope(Lam, co, n)
+    c_n = (np.log(c2_and_slope(Lam, co, n + N_STEP)[0]) - np.log(c)) / N_STEP
+    return H, sH, H_n, c, sc, c_n
 
 
 class IndentState(NamedTuple):

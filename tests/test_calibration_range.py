@@ -18,6 +18,7 @@ from spherecontact.calibration.pipeline import (
 )
 from spherecontact.calibration.synthetic import CALIBRATION_CASES, model_result
 from spherecontact.model.coefficients import Coefficients
+from spherecontact.model.single import effective_exponent, hardening_magnitude
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED_DB = ROOT / "data" / "reference_v2.h5"
@@ -29,19 +30,27 @@ KEYS = {"E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "
 OLD_KEYS = KEYS - {"K_over_sigma_y", "R_over_R_rigid"}
 
 
-def _expected(ds, beta, growth: float = 0.0, spread: float = 0.0) -> dict:
+def _expected(ds, beta, growth: float = 0.0, spread: float = 0.0, co: Coefficients | None = None) -> dict:
     """The range straight from the records: materials of the runs, extremes over the points
     (Λ with the representative strain ε_rep = β x (1 + γ x), γ = ``growth``, and the
-    representative stress of log-width ``spread``)."""
+    representative stress of log-width ``spread``); a flow table's exponent and magnitude are
+    those of the model (``single.effective_exponent``, ``single.hardening_magnitude`` with the
+    coefficient set ``co``; without one, the records must hold Ludwik curves only)."""
     mats = [c.material for c in ds.curves]
     lam = quantities(ds, beta, growth, spread)["Lambda"]
+
+    def n_of(m):
+        return effective_exponent(m, co) if m.is_tabulated else (m.n if m.K > 0 else 0.0)
+
+    def k_of(m):
+        return hardening_magnitude(m, co) if m.is_tabulated else m.K / m.sigma_y
+
     return {"E_over_sigma_y": [min(m.E / m.sigma_y for m in mats), max(m.E / m.sigma_y for m in mats)],
             "nu": [min(m.nu for m in mats), max(m.nu for m in mats)],
-            "hardening_n": [min(m.n if m.K > 0 else 0.0 for m in mats),
-                            max(m.n if m.K > 0 else 0.0 for m in mats)],
+            "hardening_n": [min(n_of(m) for m in mats), max(n_of(m) for m in mats)],
             "h_over_R_max": float(ds.h_R.max()), "a_over_R_max": float(ds.x_R.max()),
             "Lambda": [float(lam.min()), float(lam.max())],
-            "K_over_sigma_y": [min(m.K / m.sigma_y for m in mats), max(m.K / m.sigma_y for m in mats)],
+            "K_over_sigma_y": [min(k_of(m) for m in mats), max(k_of(m) for m in mats)],
             "R_over_R_rigid": [min(c.radius / c.indenter_radius for c in ds.curves),
                                max(c.radius / c.indenter_radius for c in ds.curves)]}
 
@@ -110,5 +119,6 @@ def test_shipped_file_records_the_range_of_its_calibration_runs():
         pytest.skip("data/coefficients.json was calibrated on other calibration runs")
     ds = build_dataset(runs)
     _assert_matches(d["provenance"]["calibrated_range"], _expected(ds, d["beta"], d.get("beta_growth", 0.0),
-                                                                     d.get("strain_spread", 0.0)),
+                                                                     d.get("strain_spread", 0.0),
+                                                                     Coefficients.from_dict(d)),
                     older_file_ok=True)

@@ -102,10 +102,12 @@ def test_approach_beyond_the_sphere_raises_naming_h_and_the_range():
 
 
 def test_hardening_magnitude_outside_the_calibrated_range_warns():
+    """The shipped range's hardening magnitude ends at 11.5: the Ludwik runs reach K/σY 10, a
+    saturating table (Q 2.67σY, b 12.1) 11.5 (``single.hardening_magnitude``)."""
     s1 = Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=1.0, K=12.0, n=0.3))
     with pytest.warns(CalibrationRangeWarning,
                       match=r"hardening magnitude K/sigma_y = 12 of sphere 1 is outside the calibrated "
-                            r"range \[0, 10\]"):
+                            r"range \[0, 11\.5\]"):
         contact(s1, FLAT, [0.1])
 
 
