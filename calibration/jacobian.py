@@ -21,8 +21,8 @@ out here, so a column costs a few array operations instead of an evaluation of t
 opposite, which acts through d ln H̄_hs/d ln Λ and d ln c²_hs/d ln Λ (the level functions' slopes
 and the level weight of the finite-size factors; with the exponent read along the curve,
 ``local_secant``, they move n as well, by (dn/d ln ε_rep) d ln ε_rep, which acts through
-∂ln p_m/∂n and ∂ln c²/∂n: the half-space values' by a forward step in n, the collapse limits'
-written out, ``CollapseLimit.dlog_dn``); ln Λ_I and L = ln(Λ_III/Λ_I) move
+∂ln p_m/∂n and ∂ln c²/∂n, written out: ``levels.levels_with_n_slopes`` and
+``CollapseLimit.dlog_dn``); ln Λ_I and L = ln(Λ_III/Λ_I) move
 t = (ln Λ − ln Λ_I)/L and H̄_I = 4Λ_I/(3π) (``_Parts.level_bounds``). A parameter not named
 here would get forward differences of the whole residual (scipy's '2-point' step rule). The
 penalty rows get forward differences for every parameter they depend on, those of a penalty
@@ -39,7 +39,6 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import Coefficients
-from ..model.single import N_STEP as _N_STEP
 from .forms import X_C2, counter_surface_at, exponent_slope_at, flow_log_slope_at, point_inputs
 
 __all__ = ["residual_jacobian"]
@@ -120,13 +119,10 @@ class _Parts:
         self.pos = pos = (H_hs > 0.0) & ~elastic
         zero = np.zeros_like(H_hs)
         one = np.ones_like(H_hs)
-        if co.exponent_local:  # ∂ln H̄_q/∂n, ∂ln c²_q/∂n by a forward step (n-terms: polynomials)
+        if co.exponent_local:  # ∂ln H̄_q/∂n, ∂ln c²_q/∂n (``levels.levels_with_n_slopes``)
             self.dn = exponent_slope_at(ds, co)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                self.Hq_n = np.where(pos, (np.log(levels.H_bar_and_slope(Lam, co, n + _N_STEP)[0])
-                                           - np.log(H_q)) / _N_STEP, 0.0)
-                self.cq_n = np.where(pos, (np.log(levels.c2_and_slope(Lam, co, n + _N_STEP)[0])
-                                           - np.log(c_q)) / _N_STEP, 0.0)
+            _, _, Hq_n, _, _, cq_n, _ = levels.levels_with_n_slopes(Lam, co, n)
+            self.Hq_n, self.cq_n = np.where(pos, Hq_n, 0.0), np.where(pos, cq_n, 0.0)
         if not co.has_collapse:
             self.A, self.B, self.CcH, self.Ccc = one, zero, zero, one
             self.dH_dlnk = self.dc_dlnk = self.dc_dlnkc = self.dc_ds = zero

@@ -470,6 +470,40 @@ class CollapseLimitAt:
 
 
 @dataclass(frozen=True)
+class CollapseLimitAtZ:
+    """A collapse limit at one z, for n per point (:meth:`CollapseLimit.at_z`; the exponent read
+    along the curve): ln L = log_const − exponent ln x + Σ x_poly[k] x^(k+1) + E(n)
+    + n (Σ xn_poly[k] x^(k+1) + zn_sum), E(n) = Σ exp_poly[k] n^(k+1), the x-terms continued
+    beyond x_max as :meth:`CollapseLimit.log_and_slope`."""
+
+    log_const: float
+    exponent: float
+    x_poly: tuple[float, ...]
+    xn_poly: tuple[float, ...]
+    exp_poly: tuple[float, ...]
+    zn_sum: float
+
+    def log_slope_and_dn(self, x, n, x_max: float | None = None):
+        """ln L, d ln L/d ln x and ∂ln L/∂n at (x, n) (vectorised, x > 0)."""
+        x = np.asarray(x, dtype=float)
+        n = np.asarray(n, dtype=float)
+        xc, u, ln_xc = continued_log(x, x_max)
+        s, ds = _poly_and_slope(xc, self.x_poly)
+        sn, dsn = _poly_and_slope(xc, self.xn_poly)
+        if x_max is not None:
+            s, ds = s + (ds - self.exponent) * (1.0 - u), ds * u + self.exponent * (1.0 - u)
+            sn, dsn = sn + dsn * (1.0 - u), dsn * u
+        e = np.zeros_like(n)
+        de = np.zeros_like(n)
+        for k in range(len(self.exp_poly) - 1, -1, -1):
+            e = (e + self.exp_poly[k]) * n
+            de = de * n + (k + 1) * self.exp_poly[k]
+        power = self.exponent * ln_xc if self.exponent else 0.0
+        lnL = self.log_const - power + s + e + n * (sn + self.zn_sum)
+        return lnL, ds - self.exponent + n * dsn, de + sn + self.zn_sum
+
+
+@dataclass(frozen=True)
 class CollapseLimit:
     """L(x, n, z) = prefactor · x^(−exponent)
     · exp(Σ x_poly[k] x^(k+1) + Σ exp_poly[k] n^(k+1) + n Σ xn_poly[k] x^(k+1)
@@ -547,6 +581,16 @@ class CollapseLimit:
         const = math.log(self.prefactor) + float(sz) + math.log(float(_exp_poly(1.0, self.exp_poly, n)))
         return CollapseLimitAt(log_const=const, exponent=self.exponent,
                                x_poly=poly_with_n(self.x_poly, self.xn_poly, n), dlnL_dz=float(dz))
+
+    @lru_cache(maxsize=64)  # noqa: B019 -- frozen and hashable; a body law asks for one z
+    def at_z(self, z: float, z_max: float | None = None) -> CollapseLimitAtZ:
+        """The limit at one z (float) with n left free: the z-terms of :meth:`log_and_slope`
+        summed once, for a body law whose exponent is read along the curve."""
+        sz = float(_z_terms(z, z_max, self.z_poly)[0])
+        szn = float(_z_terms(z, z_max, self.zn_poly)[0]) if self.zn_poly else 0.0
+        return CollapseLimitAtZ(log_const=math.log(self.prefactor) + sz, exponent=self.exponent,
+                                x_poly=tuple(self.x_poly), xn_poly=tuple(self.xn_poly),
+                                exp_poly=tuple(self.exp_poly), zn_sum=szn)
 
     def to_dict(self) -> dict:
         return {"prefactor": self.prefactor, "exponent": self.exponent,

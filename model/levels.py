@@ -139,6 +139,69 @@ def _smooth_shapes(t, shapes):
     return out
 
 
+def levels_with_n_slopes(Lambda, coeffs: Coefficients, n, t=None, with_c2: bool = True):
+    """H̄, d ln H̄/d ln Λ, ∂ln H̄/∂n, c², d ln c²/d ln Λ, ∂ln c²/∂n and the level index at a
+    per-point hardening exponent n (the exponent read along the curve, ``single.local_exponent``):
+    the values of :func:`H_bar_and_slope` and :func:`c2_and_slope`, and their n-slopes written
+    out, q_III(n) = P exp(Σ g_k n^(k+1)) and in Level II q = q_I + (q_III − q_I) s(t) with the
+    shape's Σ bn_k n t^k and, for H̄, m₀ = H̄_I L/(H̄_III − H̄_I) moving with n. ``with_c2`` False:
+    the c² three are None."""
+    Lam = np.asarray(Lambda, dtype=float)
+    n = np.asarray(n, dtype=float)
+    L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
+    lev = np.where(Lam <= coeffs.Lambda_I, 1, np.where(Lam < coeffs.Lambda_III, 2, 3))
+    if t is None:
+        t = level_t(Lam, coeffs)
+    one, two = lev == 1, lev == 2
+    u = 1.0 - t
+    smooth = coeffs.level_II_smooth
+    base = t * t * u * u if smooth else t * u  # the factor of P(t) in s(t)
+    H_I = coeffs.H_bar_I
+    parts = [(H_I, coeffs.H_bar_III_prefactor, coeffs.H_bar_III_exp_poly, coeffs.H_bar_shape,
+              coeffs.H_bar_shape_n, True)]
+    if with_c2:
+        parts.append((C2_HERTZ, coeffs.c2_III_prefactor, coeffs.c2_III_exp_poly, coeffs.c2_shape,
+                      coeffs.c2_shape_n, False))
+    out = []
+    for q_I, prefactor, exp_poly, b, bn, is_H in parts:
+        lnq3, g = exp_poly_log_and_slope(exp_poly, n)
+        q3 = prefactor * np.exp(lnq3)
+        P, dP = _poly_and_derivative(t, tuple(b)) if b else (0.0, 0.0)
+        Pn = dPn = 0.0
+        if bn:
+            Pn, dPn = _poly_and_derivative(t, tuple(bn))
+            P, dP = P + n * Pn, dP + n * dPn
+        if smooth:
+            m0 = H_I * L / (q3 - H_I) if is_H else 0.0
+            dm0 = -m0 * q3 * g / (q3 - H_I) if is_H else 0.0
+            sv = t * t * (3.0 - 2.0 * t) + m0 * t * u * u + base * P
+            ds = 6.0 * t * u + m0 * u * (1.0 - 3.0 * t) + 2.0 * t * u * (1.0 - 2.0 * t) * P + base * dP
+            s_n = dm0 * t * u * u + base * Pn
+        else:
+            sv = t + base * P
+            ds = 1.0 + (1.0 - 2.0 * t) * P + base * dP
+            s_n = base * Pn
+        q2 = q_I + (q3 - q_I) * sv
+        with np.errstate(divide="ignore", invalid="ignore"):
+            q = np.where(one, _HERTZ * Lam if is_H else C2_HERTZ, np.where(two, q2, q3))
+            sq = np.where(one, 1.0 if is_H else 0.0, np.where(two, (q3 - q_I) * ds / (L * q2), 0.0))
+            qn = np.where(one, 0.0, np.where(two, (q3 * g * sv + (q3 - q_I) * s_n) / q2, g))
+        out += [q, sq, qn]
+    if not with_c2:
+        out += [None, None, None]
+    return (*out, lev)
+
+
+def exp_poly_log_and_slope(exp_poly, n):
+    """Σ c_k n^(k+1) and its n-derivative Σ (k+1) c_k n^k (vectorised)."""
+    s = np.zeros_like(n)
+    d = np.zeros_like(n)
+    for k in range(len(exp_poly) - 1, -1, -1):
+        s = (s + exp_poly[k]) * n
+        d = d * n + (k + 1) * exp_poly[k]
+    return s, d
+
+
 def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_III: float, n: float = 0.0,
                     t=None, with_c2: bool = True):
     """H̄, d ln H̄/d ln Λ, c², d ln c²/d ln Λ and the level index in one pass.

@@ -49,17 +49,17 @@ import numpy as np
 
 from .coefficients import Coefficients, default_coefficients
 from .levels import (
-    H_bar_and_slope,
+    blend_from_logs,
     blend_pressure,
-    c2_and_slope,
     collapse_blend,
     collapse_pressure,
     counter_surface,
+    exp_poly_log_and_slope,
     finite_size_by_level,
-    level,
     level_t,
     level_weight,
     levels_scalar_n,
+    levels_with_n_slopes,
     onset_Lambda_u,
     onset_stage,
     stage,
@@ -210,16 +210,24 @@ def local_exponent(material: Material, eps, coeffs: Coefficients):
     return n, dn_dn0 * (m[k:] - m[:k]).reshape(eps.shape) / span
 
 
+def _stress_and_local_exponent(material: Material, eps, coeffs: Coefficients):
+    """σ_rep, d ln σ_rep/d ln ε (:func:`representative_stress`), n and dn/d ln ε
+    (:func:`local_exponent`) at ε_rep = ``eps`` from one evaluation of the averaged curve."""
+    eps = np.asarray(eps, dtype=float)
+    K, e = coeffs.exponent_window, eps.ravel()
+    sig, m = representative_stress(material, np.concatenate([e, e / K, e * K]), coeffs.strain_spread)
+    k, span = e.size, 2.0 * math.log(K)
+    n, dn_dn0 = capped_exponent(np.log(sig[2 * k:] / sig[k:2 * k]) / span, coeffs.exponent_cap)
+    shape = eps.shape
+    return (sig[:k].reshape(shape), m[:k].reshape(shape), n.reshape(shape),
+            (dn_dn0 * (m[2 * k:] - m[k:2 * k]) / span).reshape(shape))
+
+
 def capped_exponent(n0, cap: float):
     """n = n₀/(1 + (n₀/c)⁴)^¼ and dn/dn₀ = (1 + (n₀/c)⁴)^(−5/4), c = ``cap``
     (:func:`local_exponent`)."""
     q = 1.0 + (np.asarray(n0, dtype=float) / cap) ** 4
     return n0 * q ** -0.25, q ** -1.25
-
-
-#: step of the forward differences in n of the level functions and collapse limits (``BodyLaw``
-#: with a ``local_secant`` exponent): their n-terms are polynomials and exponentials of n
-N_STEP = 1e-6
 
 
 def hardening_magnitude(material: Material, coeffs: Coefficients) -> float:
@@ -304,6 +312,18 @@ class BodyLaw:
     def E_prime(self) -> float:
         return self.material.E_prime
 
+    def level_state_at(self, x) -> tuple[np.ndarray, np.ndarray]:
+        """The first two of :meth:`plastic_state_at`, s and ds/d ln x, without the pressure."""
+        mat, co = self.material, self.coeffs
+        x = np.asarray(x, dtype=float)
+        if math.isinf(mat.sigma_y):
+            zero = np.zeros_like(x)
+            return zero, zero
+        eps, g = representative_strain(x, co.beta, co.beta_growth)
+        sig, m = representative_stress(mat, eps, co.strain_spread)
+        s, ds = level_weight(mat.E_prime * x / sig, co)
+        return s, ds * (1.0 - m * g)
+
     def plastic_state_at(self, x) -> tuple[np.ndarray, ...]:
         """At x = a/ρ (vectorised): the level weight s(Λ) = 3t² − 2t³ (0 in Level I, 1 in
         Level III; ``levels.level_weight``), ds/d ln x = (ds/d ln Λ)(1 − m), the fully plastic
@@ -321,9 +341,8 @@ class BodyLaw:
         if not co.exponent_local:
             return s, ds * (1.0 - m), self.H_bar_III * sig, m
         n, dn = local_exponent(mat, eps, co)
-        H3 = co.H_bar_III(n)
-        dlnH3 = (np.log(co.H_bar_III(n + N_STEP)) - np.log(H3)) / N_STEP
-        return s, ds * (1.0 - m), H3 * sig, m + dlnH3 * dn * g
+        lnH3, dlnH3 = exp_poly_log_and_slope(co.H_bar_III_exp_poly, n)
+        return s, ds * (1.0 - m), co.H_bar_III_prefactor * np.exp(lnH3) * sig, m + dlnH3 * dn * g
 
     def _piece(self, Lam, eps, y, x) -> np.ndarray:
         """Smooth-piece id from the level of Λ (``levels.stage``), the stage of the unloading
@@ -381,6 +400,10 @@ class BodyLaw:
             sig = np.full_like(x, math.inf)
             Lam = np.zeros_like(x)
             m = np.zeros_like(x)
+        elif co.exponent_local:  # σ_rep at ε_rep, ε_rep/K and K ε_rep in one evaluation
+            sig, m, n, n_x = _stress_and_local_exponent(mat, eps, co)
+            Lam = Ep * x / sig
+            m, n_x = m * g, n_x * g  # d ln σ_rep/d ln x, dn/d ln x
         else:
             sig, m = representative_stress(mat, eps, co.strain_spread)
             Lam = Ep * x / sig
@@ -389,10 +412,7 @@ class BodyLaw:
         t = level_t(Lam, co)
         local = co.exponent_local and not math.isinf(mat.sigma_y)
         if local:  # n(x) along the curve: its slope n_x = dn/d ln x enters every n-term
-            n, n_x = local_exponent(mat, eps, co)
-            n_x = n_x * g
-            H, sH, H_n, c, sc, c_n = _levels_and_n_slopes(Lam, co, n, with_c2)
-            lev = level(Lam, co)
+            H, sH, H_n, c, sc, c_n, lev = levels_with_n_slopes(Lam, co, n, t, with_c2)
         else:
             n = self.n_eff
             H, sH, c, sc, lev = levels_scalar_n(Lam, co, self.H_bar_III, self.c2_III, n, t, with_c2)
@@ -420,7 +440,7 @@ class BodyLaw:
             else:  # u = xc − y moves with a only: every slope in the y slot, the level weight too
                 su, su_x, su_y = counter_surface(np.asarray(xc, dtype=float), y)
                 su_x, su_y = 0.0, su_x + su_y
-                s_c, ds_c = self.plastic_state_at(np.asarray(xc, dtype=float))[:2]
+                s_c, ds_c = self.level_state_at(np.asarray(xc, dtype=float))
                 lev_x, lev_y = 0.0, ds_c
             (qH, dqH), (qc, dqc) = co.counter_by_level(s_c)  # q(s), dq/ds
             p = p * np.exp(qH * su)
@@ -456,43 +476,28 @@ class BodyLaw:
 
     def _collapse_local(self, p, sig, m, c, y, n, n_x, z, Lam, piece, dp, dc) -> BodyResponse:
         """The collapse blend of :meth:`response` with n read along the curve: the limits'
-        n-terms move with x, ∂ln H̄_c/∂ln x += (∂ln H̄_c/∂n) n_x (likewise c²_c), in the x slot."""
+        n-terms move with x, ∂ln H̄_c/∂ln x += (∂ln H̄_c/∂n) n_x (likewise c²_c), in the x slot
+        (``levels.collapse_blend``'s equations; the limits at the pair's z, ``CollapseLimit.at_z``)."""
         co = self.coeffs
-        zv, zm, xm = co.collapse_z(z), co.collapse_z(co.z_fit_max), co.x_fit_max
-        Hc_n = co.collapse_H_bar.dlog_dn(y, n, zv, xm, zm)
+        zv, zm, xm = float(co.collapse_z(z)), float(co.collapse_z(co.z_fit_max)), co.x_fit_max
+        lnHc, sHc, Hc_n = co.collapse_H_bar.at_z(zv, zm).log_slope_and_dn(y, n, xm)
         (dp_x, dp_y), (dc_x, dc_y) = dp, dc
         if c is None:  # pressure only: the H̄ half of the blend (``levels.collapse_pressure``)
-            lnHc, dlnHc = co.collapse_H_bar.log_and_slope(y, n, zv, xm, zm)[:2]
             Hb, w, _ = blend_pressure(p / sig, lnHc, co.collapse_sharpness)
             return BodyResponse(p_m=Hb * sig, c2=None, Lambda=Lam, sigma_rep=sig,
                                 dlnp_dlnx=(1.0 - w) * dp_x + w * (m + Hc_n * n_x),
-                                dlnp_dlny=(1.0 - w) * dp_y + w * dlnHc,
+                                dlnp_dlny=(1.0 - w) * dp_y + w * sHc,
                                 dlnc2_dlnx=None, dlnc2_dlny=None, piece=None)
-        b = collapse_blend(p / sig, c, y, co, n, z)
-        w, wc = b.w, b.w_c2
-        dr_x, dr_y = dp_x - m - Hc_n * n_x, dp_y - b.dlnHc_dlnx  # ∂ln r
-        p_m = b.H_bar * sig
-        dp_x, dp_y = (1.0 - w) * dp_x + w * (m + Hc_n * n_x), (1.0 - w) * dp_y + w * b.dlnHc_dlnx
-        cc_n = co.collapse_c2.dlog_dn(y, n, zv, xm, zm)
-        v = co.c2_sharpness * wc * (1.0 - wc) * b.lnc2_gap
-        dc_x = (1.0 - wc) * dc_x + wc * cc_n * n_x + v * dr_x
-        dc_y = (1.0 - wc) * dc_y + wc * b.dlnc2c_dlnx + v * dr_y
-        return BodyResponse(p_m=p_m, c2=b.c2, Lambda=Lam, sigma_rep=sig, dlnp_dlnx=dp_x,
-                            dlnp_dlny=dp_y, dlnc2_dlnx=dc_x, dlnc2_dlny=dc_y, piece=piece)
-
-
-def _levels_and_n_slopes(Lam, co: Coefficients, n, with_c2: bool):
-    """H̄, d ln H̄/d ln Λ, ∂ln H̄/∂n and (with ``with_c2``) the same three of c² at per-point n
-    (``levels.H_bar_and_slope``, ``levels.c2_and_slope``; ∂/∂n by a forward step)."""
-    H, sH = H_bar_and_slope(Lam, co, n)
-    with np.errstate(divide="ignore", invalid="ignore"):  # H̄ = 0 at x = 0: no n-slope
-        H_n = np.where(H > 0.0, (np.log(H_bar_and_slope(Lam, co, n + N_STEP)[0]) - np.log(H))
-                       / N_STEP, 0.0)
-    if not with_c2:
-        return H, sH, H_n, None, None, None
-    c, sc = c2_and_slope(Lam, co, n)
-    c_n = (np.log(c2_and_slope(Lam, co, n + N_STEP)[0]) - np.log(c)) / N_STEP
-    return H, sH, H_n, c, sc, c_n
+        lncc, scc, cc_n = co.collapse_c2.at_z(zv, zm).log_slope_and_dn(y, n, xm)
+        Hb, c2, w, gap, wc = blend_from_logs(p / sig, c, lnHc, lncc, co.collapse_sharpness,
+                                             co.collapse_sharpness_c2, co.collapse_offset_c2)
+        dr_x, dr_y = dp_x - m - Hc_n * n_x, dp_y - sHc  # ∂ln r
+        v = co.c2_sharpness * wc * (1.0 - wc) * gap
+        return BodyResponse(
+            p_m=Hb * sig, c2=c2, Lambda=Lam, sigma_rep=sig,
+            dlnp_dlnx=(1.0 - w) * dp_x + w * (m + Hc_n * n_x), dlnp_dlny=(1.0 - w) * dp_y + w * sHc,
+            dlnc2_dlnx=(1.0 - wc) * dc_x + wc * cc_n * n_x + v * dr_x,
+            dlnc2_dlny=(1.0 - wc) * dc_y + wc * scc + v * dr_y, piece=piece)
 
 
 class IndentState(NamedTuple):
