@@ -25,8 +25,10 @@ where H̄ and c² include the finite-size factor f(y, Λ) (its Λ-dependence thr
 level weight enters d/d ln Λ; y is the finite-size ratio).
 
 With a collapse block (``levels.collapse_blend``; y = finite-size ratio, n = effective
-exponent), the half-space p_hs = H̄_hs σ_rep and c²_hs are blended with the whole-body
-limits: ln r = ln p_hs − ln σ_rep − ln H̄_c(y, n, z), w = r^k/(1 + r^k),
+exponent: one per material, or read along the curve at ε_rep, :func:`local_exponent`, whose
+slope dn/d ln x then enters every slope below through the n-terms), the half-space
+p_hs = H̄_hs σ_rep and c²_hs are blended with the whole-body limits:
+ln r = ln p_hs − ln σ_rep − ln H̄_c(y, n, z), w = r^k/(1 + r^k),
 w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c)) (s constant), p_m = p_hs (1 + r^k)^(−1/k),
 c² = c²_hs^(1−w_c) c²_c(y, n, z)^(w_c), and
 
@@ -203,11 +205,7 @@ def local_exponent(material: Material, eps, coeffs: Coefficients):
     if material.is_rigid or math.isinf(material.sigma_y):
         zero = np.zeros_like(eps)
         return zero, zero
-    K, e = coeffs.exponent_window, eps.ravel()
-    sig, m = representative_stress(material, np.concatenate([e / K, e * K]), coeffs.strain_spread)
-    k, span = e.size, 2.0 * math.log(K)
-    n, dn_dn0 = capped_exponent(np.log(sig[k:] / sig[:k]).reshape(eps.shape) / span, coeffs.exponent_cap)
-    return n, dn_dn0 * (m[k:] - m[:k]).reshape(eps.shape) / span
+    return _stress_and_local_exponent(material, eps, coeffs)[2:]
 
 
 def _stress_and_local_exponent(material: Material, eps, coeffs: Coefficients):
@@ -472,7 +470,6 @@ class BodyLaw:
             dlnp_dlnx=dp_x, dlnp_dlny=dp_y,
             dlnc2_dlnx=dc_x, dlnc2_dlny=dc_y, piece=piece,
         )
-
 
     def _collapse_local(self, p, sig, m, c, y, n, n_x, z, Lam, piece, dp, dc) -> BodyResponse:
         """The collapse blend of :meth:`response` with n read along the curve: the limits'
