@@ -123,11 +123,10 @@ class _Parts:
             self.dn = exponent_slope_at(ds, co)
             _, _, Hq_n, _, _, cq_n, _ = levels.levels_with_n_slopes(Lam, co, n)
             self.Hq_n, self.cq_n = np.where(pos, Hq_n, 0.0), np.where(pos, cq_n, 0.0)
+            self.p_n, self.c_n = self.Hq_n, self.cq_n  # without a collapse block
         if not co.has_collapse:
             self.A, self.B, self.CcH, self.Ccc = one, zero, zero, one
             self.dH_dlnk = self.dc_dlnk = self.dc_dlnkc = self.dc_ds = zero
-            if co.exponent_local:
-                self.p_n, self.c_n = self.Hq_n, self.cq_n
             return
         lnHc = co.collapse_H_bar.log_and_slope(y, n, z)[0]
         lncc = co.collapse_c2.log_and_slope(y, n, z)[0]

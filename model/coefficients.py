@@ -377,6 +377,18 @@ def _limit(d, where: str) -> CollapseLimit:
                          zn_poly=_poly(d, "zn_poly", where + ".") if "zn_poly" in d else ())
 
 
+def exp_poly_log_and_slope(exp_poly, n):
+    """Σ c_k n^(k+1) and its n-derivative Σ (k+1) c_k n^k (vectorised in n): the exponent of
+    :func:`_exp_poly` and its slope, for the exponent read along the curve."""
+    n = np.asarray(n, dtype=float)
+    s = np.zeros_like(n)
+    d = np.zeros_like(n)
+    for k in range(len(exp_poly) - 1, -1, -1):
+        s = (s + exp_poly[k]) * n
+        d = d * n + (k + 1) * exp_poly[k]
+    return s, d
+
+
 def _exp_poly(prefactor: float, exp_poly: tuple[float, ...], n):
     """prefactor · exp(Σ_k c_k n^(k+1)), vectorised in n."""
     n = np.asarray(n, dtype=float)
@@ -493,11 +505,7 @@ class CollapseLimitAtZ:
         if x_max is not None:
             s, ds = s + (ds - self.exponent) * (1.0 - u), ds * u + self.exponent * (1.0 - u)
             sn, dsn = sn + dsn * (1.0 - u), dsn * u
-        e = np.zeros_like(n)
-        de = np.zeros_like(n)
-        for k in range(len(self.exp_poly) - 1, -1, -1):
-            e = (e + self.exp_poly[k]) * n
-            de = de * n + (k + 1) * self.exp_poly[k]
+        e, de = exp_poly_log_and_slope(self.exp_poly, n)
         power = self.exponent * ln_xc if self.exponent else 0.0
         lnL = self.log_const - power + s + e + n * (sn + self.zn_sum)
         return lnL, ds - self.exponent + n * dsn, de + sn + self.zn_sum
@@ -555,10 +563,8 @@ class CollapseLimit:
         """∂ln L/∂n at x, n, z (vectorised; the same continuations as :meth:`log_and_slope`):
         Σ (k+1) exp_poly[k] n^k + Σ xn_poly[k] x^(k+1) + Σ zn_poly[k] z^(k+1)."""
         x = np.asarray(x, dtype=float)
-        n_ = np.asarray(n, dtype=float)
-        d = np.zeros(np.broadcast_shapes(x.shape, n_.shape, np.shape(z)))
-        for k in range(len(self.exp_poly) - 1, -1, -1):  # d/dn Σ c_k n^(k+1)
-            d = d * n_ + (k + 1) * self.exp_poly[k]
+        d = exp_poly_log_and_slope(self.exp_poly, n)[1] + np.zeros(np.broadcast_shapes(
+            x.shape, np.shape(n), np.shape(z)))
         if self.xn_poly:
             xc, u = continue_beyond(x, x_max)
             sn, dsn = _poly_and_slope(xc, self.xn_poly)

@@ -33,7 +33,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .coefficients import Coefficients, _poly_and_slope, continue_beyond, continued_log, poly_with_n
+from .coefficients import (
+    Coefficients,
+    _poly_and_slope,
+    continue_beyond,
+    continued_log,
+    exp_poly_log_and_slope,
+    poly_with_n,
+)
 
 __all__ = [
     "C2_HERTZ",
@@ -149,7 +156,7 @@ def levels_with_n_slopes(Lambda, coeffs: Coefficients, n, t=None, with_c2: bool 
     Lam = np.asarray(Lambda, dtype=float)
     n = np.asarray(n, dtype=float)
     L = math.log(coeffs.Lambda_III / coeffs.Lambda_I)
-    lev = np.where(Lam <= coeffs.Lambda_I, 1, np.where(Lam < coeffs.Lambda_III, 2, 3))
+    lev = level(Lam, coeffs)
     if t is None:
         t = level_t(Lam, coeffs)
     one, two = lev == 1, lev == 2
@@ -190,16 +197,6 @@ def levels_with_n_slopes(Lambda, coeffs: Coefficients, n, t=None, with_c2: bool 
     if not with_c2:
         out += [None, None, None]
     return (*out, lev)
-
-
-def exp_poly_log_and_slope(exp_poly, n):
-    """Σ c_k n^(k+1) and its n-derivative Σ (k+1) c_k n^k (vectorised)."""
-    s = np.zeros_like(n)
-    d = np.zeros_like(n)
-    for k in range(len(exp_poly) - 1, -1, -1):
-        s = (s + exp_poly[k]) * n
-        d = d * n + (k + 1) * exp_poly[k]
-    return s, d
 
 
 def levels_scalar_n(Lambda: np.ndarray, coeffs: Coefficients, H_III: float, c2_III: float, n: float = 0.0,
@@ -369,7 +366,7 @@ def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
     sharpnesses k (H̄) and k_c (c²; None: k) and the offset s_c of the c² weight (None: 0):
     returns H̄, c², the weight w = r^k/(1 + r^k) (r = H_hs/H̄_c), ln c²_c − ln c²_hs (0 where
     w = w_c = 0) and w_c = (r e^s)^(k_c)/(1 + (r e^s)^(k_c))."""
-    H, w, lnr = _blend_H(H_hs, lnHc, k)
+    H, w, lnr = blend_pressure(H_hs, lnHc, k)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         if (k_c is None or k_c == k) and not s_c:
             wc = w
@@ -381,11 +378,6 @@ def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
 
 def blend_pressure(H_hs, lnHc, k: float):
     """The H̄ half of :func:`blend_from_logs`: H̄, w and ln r = ln H_hs − ln H̄_c."""
-    return _blend_H(H_hs, lnHc, k)
-
-
-def _blend_H(H_hs, lnHc, k: float):
-    """The H̄ half of :func:`blend_from_logs`: H̄, w and ln r = ln H_hs − ln H̄_c."""
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
         w, log1p = _weight(k * lnr)
@@ -396,7 +388,7 @@ def collapse_pressure(H_hs, x, coeffs: Coefficients, n: float, z: float):
     """The H̄ half of :func:`collapse_blend` for one body law (n, z numbers; ``coeffs`` with a
     collapse block): the blended H̄, the weight w and d ln H̄_c/d ln x."""
     lnHc, sHc, _ = _limit_at(coeffs.collapse_H_bar, coeffs, n, z).log_and_slope(x, coeffs.x_fit_max)
-    H, w, _ = _blend_H(np.asarray(H_hs, dtype=float), lnHc, coeffs.collapse_sharpness)
+    H, w, _ = blend_pressure(np.asarray(H_hs, dtype=float), lnHc, coeffs.collapse_sharpness)
     return H, w, sHc
 
 

@@ -49,14 +49,13 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .coefficients import Coefficients, default_coefficients
+from .coefficients import Coefficients, default_coefficients, exp_poly_log_and_slope
 from .levels import (
     blend_from_logs,
     blend_pressure,
     collapse_blend,
     collapse_pressure,
     counter_surface,
-    exp_poly_log_and_slope,
     finite_size_by_level,
     level_t,
     level_weight,
@@ -333,12 +332,14 @@ class BodyLaw:
             zero = np.zeros_like(x)
             return zero, zero, np.full_like(x, math.inf), zero
         eps, g = representative_strain(x, co.beta, co.beta_growth)
-        sig, m = representative_stress(mat, eps, co.strain_spread)
+        if not co.exponent_local:
+            sig, m = representative_stress(mat, eps, co.strain_spread)
+            m = m * g
+            s, ds = level_weight(mat.E_prime * x / sig, co)
+            return s, ds * (1.0 - m), self.H_bar_III * sig, m
+        sig, m, n, dn = _stress_and_local_exponent(mat, eps, co)
         m = m * g
         s, ds = level_weight(mat.E_prime * x / sig, co)
-        if not co.exponent_local:
-            return s, ds * (1.0 - m), self.H_bar_III * sig, m
-        n, dn = local_exponent(mat, eps, co)
         lnH3, dlnH3 = exp_poly_log_and_slope(co.H_bar_III_exp_poly, n)
         return s, ds * (1.0 - m), co.H_bar_III_prefactor * np.exp(lnH3) * sig, m + dlnH3 * dn * g
 
