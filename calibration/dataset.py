@@ -9,7 +9,10 @@ relative radius
 and, with h the approach taken by this body, the Brinell-type quantities are
 
     ε_rep = β a/ρ,  σ_rep = σ_f(ε_rep),  Λ = E' a/(σ_rep ρ),
-    H̄ = p_m/σ_rep = F/(π a² σ_rep),   c² = a²/(2 h ρ).
+    H̄ = p_m/σ_rep = F/(π a² σ_rep),   c² = a² G/(2 h ρ),
+
+G = 1 + ρφ(a/R_i)/R_i the rigid sphere's exact cap over its paraboloid (``model.cap``; 1 on a
+flat): c² is the gap the body closes over its approach, as the model's h reads it.
 
 Only σ_rep (hence Λ and H̄) depends on the coefficient β; :func:`quantities` evaluates
 them for any β, :class:`Dataset` holds what does not depend on it.
@@ -43,6 +46,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.cap import cap_gap_factor
 from ..model.material import Material
 from ..model.single import representative_strain, representative_stress
 
@@ -200,7 +204,7 @@ class Dataset:
     R: np.ndarray
     E_prime: np.ndarray
     p_m: np.ndarray    # F/(π a²)
-    c2: np.ndarray     # a²/(2 h ρ)
+    c2: np.ndarray     # a² G/(2 h ρ), G the rigid sphere's exact cap (``model.cap``; 1 on a flat)
     x_R: np.ndarray    # a/R
     x_rho: np.ndarray  # a/ρ
     h_R: np.ndarray    # h/R
@@ -261,8 +265,9 @@ def build_dataset_from_curves(curves: Iterable[RunCurve]) -> Dataset:
     rho = cat(lambda c: np.full(c.h.size, c.rho))
     R = cat(lambda c: np.full(c.h.size, c.radius))
     Ep = cat(lambda c: np.full(c.h.size, c.material.E_prime))
+    cap = cat(lambda c: cap_gap_factor(c.a, 1.0 / c.rho, c.indenter_radius)[0])
     return Dataset(curves=curves, run=run, h=h, F=F, a=a, rho=rho, R=R, E_prime=Ep,
-                   p_m=F / (math.pi * a * a), c2=a * a / (2.0 * h * rho), x_R=a / R, x_rho=a / rho,
+                   p_m=F / (math.pi * a * a), c2=a * a * cap / (2.0 * h * rho), x_R=a / R, x_rho=a / rho,
                    h_R=h / R, slope_F=cat(lambda c: _log_slope(c.h, c.F)),
                    slope_a=cat(lambda c: _log_slope(c.h, c.a)))
 

@@ -45,6 +45,9 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   q = (1 − s_l) q + s_l q_III with the level weight s_l as for the finite-size factors
   (absent: q_III = q). Against a small rigid sphere c² rises with a/R_i while the body is
   elastic–plastic and falls once it is fully plastic (pile-up around the indenter);
+* counter cap (optional ``counter_cap``, absent: ``paraboloid``): ``exact`` adds to the gap a
+  body closes the depth of a rigid (or much harder, by its weight w) partner's spherical cap
+  beyond its paraboloid, h = (a²/(2ρ) + w e)/c² (``cap.py``); c² was calibrated with it;
 * representative stress (optional ``strain_spread`` W ≥ 0, absent: 0): σ_rep is the flow
   curve averaged over a log-normal distribution of strains about ε_rep,
   σ_rep = ⅔ σ_f(ε_rep) + ⅙ σ_f(ε_rep e^(−√3W)) + ⅙ σ_f(ε_rep e^(√3W)) (three-point
@@ -107,6 +110,8 @@ RATIOS = ("a_over_rho", "a_over_R")
 #: ln(1 + max(z, 0)) = ln(R/ρ_c) (0 for z ≤ 0, where no calibration run lies)
 Z_VARIABLES = ("z", "ln(1+z)")
 EXPONENT_METHODS = ("secant_loglog", "local_secant")
+#: shape of a rigid partner's surface in the gap a body closes (``counter_cap``, ``cap.py``)
+COUNTER_CAPS = ("paraboloid", "exact")
 #: allowed ranges of the ``local_secant`` exponent's window factor and cap
 EXPONENT_WINDOW_RANGE = (1.5, 10.0)
 EXPONENT_CAP_RANGE = (0.1, 2.0)
@@ -182,7 +187,8 @@ LITERATURE: dict = {
 #: ≈ 32 between the outer quadrature strains and ε_rep)
 SPREAD_MAX = 2.0
 
-_OPTIONAL_TOP_KEYS = ("beta_growth", "strain_spread", "interface", "counter_surface", "unloading")
+_OPTIONAL_TOP_KEYS = ("beta_growth", "strain_spread", "interface", "counter_surface", "counter_cap",
+                      "unloading")
 
 #: bound of the counter-surface coefficients: |q| ≤ 2 keeps d ln F/d ln a and d ln h/d ln a
 #: above 2 − |q|/2 ≥ 1 from these terms (ds/d ln u ≤ ½)
@@ -658,6 +664,8 @@ class Coefficients:
     interface_similarity: float = 0.2
     interface_radius: float = 1.0
     interface_exponent: float = 4.0
+    #: the rigid partner's cap in h: "paraboloid" (a²/(2ρ) alone) or "exact" (``cap.py``)
+    counter_cap: str = "paraboloid"
     #: unloading law (``unloading.py``); the default is Thornton (1997)
     unloading: UnloadingCoefficients = field(default_factory=UnloadingCoefficients)
     source: str = "literature"
@@ -695,6 +703,7 @@ class Coefficients:
                              f"got {spread!r}")
         interface = _interface(d)
         counter = _counter(d)
+        counter_cap = _choice(d, "counter_cap", "", COUNTER_CAPS) if "counter_cap" in d else "paraboloid"
         unloading = _unloading(d)
         lam1 = _number(d, "Lambda_I", "")
         lam3 = _number(d, "Lambda_III", "")
@@ -813,6 +822,7 @@ class Coefficients:
             beta_growth=growth, strain_spread=spread,
             **interface,
             **counter,
+            counter_cap=counter_cap,
             **unloading,
             source=source,
             schema_version=version,
@@ -835,6 +845,7 @@ class Coefficients:
                               "exponent": self.interface_exponent}}
                if self.interface_coupling else {}),
             **({"counter_surface": self._counter_section()} if self.has_counter_surface else {}),
+            **({"counter_cap": self.counter_cap} if self.counter_cap != "paraboloid" else {}),
             **({"unloading": self.unloading.to_dict()}
                if self.unloading != UnloadingCoefficients() else {}),
             "Lambda_I": self.Lambda_I,

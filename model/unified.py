@@ -8,7 +8,9 @@ For a given contact radius a, κ follows from equal mean pressures
 
     p_m = H̄(Λ_1) σ_rep,1 = H̄(Λ_2) σ_rep,2,   Λ_i = E'_i a/(σ_rep,i ρ_i),
 
-and h_i = a²/(2 c_i² ρ_i), h = h_1 + h_2, F = π a² p_m. The κ root is found in the
+and h_i = a²/(2 c_i² ρ_i), h = h_1 + h_2, F = π a² p_m (with ``counter_cap = "exact"``,
+h_i = (a²/(2ρ_i) + w_i e_i)/c_i², e_i the depth of the partner's cap beyond its paraboloid and
+w_i its weight, ``cap.py``). The κ root is found in the
 variable u = ln(ρ_2/ρ_1) (ρ_1/R* = 1 + e^(−u)), where g(u) = ln p_1 − ln p_2 increases
 monotonically; in Level I the root is u = ln(E'_2/E'_1) (ρ_i = E'_i R*/E*, Hertz).
 
@@ -60,6 +62,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .cap import cap_gap_factor
 from .coefficients import Coefficients, default_coefficients
 from .roots import solve_increasing
 from .single import BodyLaw, BodyResponse, curvature_ratio
@@ -209,6 +212,12 @@ class UnifiedPair:
             w = harder_partner_weight(s_, s_o)
             self._inv_rho_c[id(law)] = (1.0 - w) / rho_h + w / self.R_star
             self._z[id(law)] = curvature_ratio(s_.radius, 1.0 / self._inv_rho_c[id(law)])
+        # weight and radius of the partner's cap in each body's gap (``cap.py``; weight 0: paraboloid)
+        self._cap = {}
+        for law, s_, s_o in ((self.law1, s1, s2), (self.law2, s2, s1)):
+            if law is not None:
+                w = 1.0 if s_o.is_rigid else harder_partner_weight(s_, s_o)
+                self._cap[id(law)] = (s_o.radius, w if self.coeffs.counter_cap == "exact" else 0.0)
 
     # ------------------------------------------------------------------ body responses
     def _body(self, law: BodyLaw, a, k, R, pressure_only: bool = False) -> BodyResponse:
@@ -297,10 +306,11 @@ class UnifiedPair:
         if self.mode in ("rigid1", "rigid2"):
             law, R = (self.law1, R1) if self.mode == "rigid2" else (self.law2, R2)
             r = self._body(law, a, 1.0 / Rs, R)
-            hb = a * a / (Rs * 2.0 * r.c2)
+            G, dlnG = cap_gap_factor(a, 1.0 / Rs, *self._cap[id(law)])
+            hb = a * a / (Rs * 2.0 * r.c2) * G
             F = math.pi * a * a * r.p_m
             dlnF = 2.0 + r.dlnp_dlnx + r.dlnp_dlny
-            dlnh = 2.0 - r.dlnc2_dlnx - r.dlnc2_dlny
+            dlnh = 2.0 - r.dlnc2_dlnx - r.dlnc2_dlny + dlnG
             stiff = F * dlnF / (hb * dlnh)
             if self.mode == "rigid2":
                 kappa = np.full_like(a, -1.0 / R2)
@@ -361,10 +371,13 @@ class UnifiedPair:
         # p_1 = p_2 (λ = 0); with the coupling term the contact pressure is their geometric mean
         p = np.sqrt(r1.p_m * r2.p_m)
         dlnp = 0.5 * (B1 + A1 * dlnk1 + B2 + A2 * dlnk2)
-        h1 = a * a * k1 / (2.0 * r1.c2)
-        h2 = a * a * k2 / (2.0 * r2.c2)
-        dlnh1 = 2.0 + (1.0 - Ca1) * dlnk1 - Cb1
-        dh = h1 * dlnh1 + h2 * (2.0 + (1.0 - Ca2) * dlnk2 - Cb2)
+        # h_i = a²k_i G_i/(2c_i²), G_i the partner's cap (``cap.py``; ∂ln G_i/∂ln k_i = 1/G_i − 1)
+        G1, dlnG1 = cap_gap_factor(a, k1, *self._cap[id(self.law1)])
+        G2, dlnG2 = cap_gap_factor(a, k2, *self._cap[id(self.law2)])
+        h1 = a * a * k1 / (2.0 * r1.c2) * G1
+        h2 = a * a * k2 / (2.0 * r2.c2) * G2
+        dlnh1 = 2.0 + (1.0 / G1 - Ca1) * dlnk1 - Cb1 + dlnG1
+        dh = h1 * dlnh1 + h2 * (2.0 + (1.0 / G2 - Ca2) * dlnk2 - Cb2 + dlnG2)
         F = math.pi * a * a * p
         h = h1 + h2
         dlnF = 2.0 + dlnp

@@ -22,6 +22,7 @@ from spherecontact.calibration.synthetic import (
 )
 from spherecontact.fem.io import Run
 from spherecontact.model import Material
+from spherecontact.model.cap import cap_gap_factor
 from spherecontact.model.coefficients import Coefficients, load_coefficients
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,6 +31,7 @@ SHIPPED_DB = ROOT / "data" / "reference_v2.h5"
 #: a known coefficient set (the structure of the smooth form) the synthetic runs come from
 KNOWN = {
     "schema_version": 2, "source": "calibration", "provenance": {}, "beta": 0.25,
+    "counter_cap": "exact",  # the geometry the calibration's c² is read with (``dataset``)
     "Lambda_I": 2.5, "Lambda_III": 150.0,
     "H_bar_III": {"prefactor": 2.9, "exp_poly": [0.3]},
     "c2_III": {"prefactor": 1.35, "exp_poly": [-0.8]},
@@ -84,7 +86,10 @@ def test_hertz_run_gives_hertz_levels(indenter_radius):
         q = quantities(ds, beta)
         np.testing.assert_allclose(q["H_bar"], 4.0 * q["Lambda"] / (3.0 * math.pi), rtol=1e-10)
         np.testing.assert_allclose(q["sigma_rep"], m.flow_stress(beta * ds.a / rho), rtol=1e-12)
-    np.testing.assert_allclose(ds.c2, 0.5, rtol=1e-10)
+    # a² = R* h with the paraboloid: c² = G/2, G the sphere's exact cap over it (1 on a flat)
+    G = cap_gap_factor(ds.a, 1.0 / rho, indenter_radius)[0]
+    np.testing.assert_allclose(ds.c2, 0.5 * G, rtol=1e-10)
+    assert (G == 1.0).all() if math.isinf(indenter_radius) else 1.0 < G.min() < G.max() < 1.03
     assert ds.a.min() >= 0.02 - 1e-12  # resolution filter at the default mesh density
     # grid: 16 nodes per decade of h, shared by every run, plus the final approach
     lnh = np.log(ds.h[:-1])

@@ -195,18 +195,18 @@ def test_an_inconsistent_partition_is_an_error_not_a_value():
     """Beyond h/R ≈ 0.36 two elastic–perfectly plastic spheres whose pressures no longer depend
     on the partition can leave the κ equation without a single root: the state found then has
     h₁ + h₂ ≠ h, or the inversion does not converge. The model raises, naming the approach,
-    instead of returning a state (here from h/R = 0.475 on; with the coefficients of 2026-11-27,
-    3 of 300 random plastic pairs of radius ratio 0.25–4, yield ratio 1–2.5 and E ratio 0.3–3
-    raise somewhere in h/R 0.30–0.48, none below h/R 0.3)."""
+    instead of returning a state (here from h/R = 0.446 on; with the coefficients of 2026-11-27,
+    second half, 4 of 300 random plastic pairs of radius ratio 0.25–4, yield ratio 1–2.5 and E
+    ratio 0.3–3 raise somewhere in h/R 0.45–0.50, none below h/R 0.44)."""
     import numpy as np
     import pytest
 
     from spherecontact.model import Material, Sphere, contact
 
-    s1 = Sphere(1.0, Material(E=748.930, nu=0.312813, sigma_y=1.0))
-    s2 = Sphere(0.360661, Material(E=490.634, nu=0.262307, sigma_y=1.58010))
-    h_ok = 0.360661 * np.linspace(0.01, 0.3, 100)
+    s1 = Sphere(1.0, Material(E=2143.12, nu=0.268349, sigma_y=1.0))
+    s2 = Sphere(0.365052, Material(E=3342.54, nu=0.247789, sigma_y=1.46889))
+    h_ok = 0.365052 * np.linspace(0.01, 0.3, 100)
     ok = contact(s1, s2, h_ok)  # inside the calibrated h/R
     np.testing.assert_allclose(ok.h1 + ok.h2, h_ok, rtol=1e-9)
-    with pytest.raises(ValueError, match=r"(no consistent root|did not converge).* at h = 0\.17"):
-        contact(s1, s2, 0.360661 * np.linspace(0.01, 0.5, 400))
+    with pytest.raises(ValueError, match=r"(no consistent root|did not converge).* at h = 0\.16"):
+        contact(s1, s2, 0.365052 * np.linspace(0.01, 0.5, 400))
