@@ -2,7 +2,8 @@
 
 A sphere of radius R_o is R_o − √(R_o² − a²) deep at radius a, not a²/(2R_o):
 
-    R_o − √(R_o² − a²) = a²/(2R_o) (1 + φ(t)),   φ(t) = (1 − s)/(1 + s) = t²/(1 + s)²,  s = √(1 − t²),  t = a/R_o,
+    R_o − √(R_o² − a²) = a²/(2R_o) (1 + φ(t)),
+    φ(t) = (1 − s)/(1 + s) = t²/(1 + s)²,   s = √(1 − t²),   t = a/R_o,
 
 φ ≈ t²/4 for small t, 0.09 at t = 0.55, 0.39 at t = 0.9. A body pressed by a rigid sphere shortens
 by the gap it closes, a²/(2ρ) + e with the excess e = a²φ(t)/(2R_o), over its c² (``unified.py``):
