@@ -584,18 +584,11 @@ FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz"] = _derived(
     "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz", "as "
     "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn, the collapse limits' z-terms in ln(1 + z) = ln(R/ρ_c)",
     z_log=True)
-FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn_nl"] = _derived(
-    "smooth2_fs2_xn2n_x2_g_csl_w1_sn", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_nl", "as "
-    "smooth2_fs2_xn2n_x2_g_csl_w1_sn, the hardening exponent read along the curve (secant over "
-    "[ε_rep/3, 3ε_rep], capped at 0.5)", exponent_window=3.0)
-FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl"] = _derived(
-    "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl", "as "
-    "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn, the hardening exponent read along the curve (secant "
-    "over [ε_rep/3, 3ε_rep], capped at 0.5)", exponent_window=3.0)
-FORMS["smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz_nl"] = _derived(
-    "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz_nl", "as "
-    "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz, the hardening exponent read along the curve (secant "
-    "over [ε_rep/3, 3ε_rep], capped at 0.5)", exponent_window=3.0)
+for _base in ("smooth2_fs2_xn2n_x2_g_csl_w1_sn", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn",
+              "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_lz"):  # each with the exponent along the curve
+    FORMS[_base + "_nl"] = _derived(
+        _base, _base + "_nl", f"as {_base}, the hardening exponent read along the curve (secant over "
+        "[ε_rep/3, 3ε_rep], capped at 0.5)", exponent_window=3.0)
 FORMS["smooth2_fs2_xn2n_x3_g_csl_w1"] = _derived(
     "smooth2_fs2_xn2n_x2_g_csl_w1", "smooth2_fs2_xn2n_x3_g_csl_w1", "as smooth2_fs2_xn2n_x2_g_csl_w1, both "
     "collapse limits cubic in a/R", n_collapse_H=3, n_collapse_c=3)

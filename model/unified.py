@@ -202,9 +202,13 @@ class UnifiedPair:
         # radius ρ_c of the surface pressing each body, 1/ρ_c = (1 − w)/ρ_H + w/R* (Hertz partition
         # ρ_H = E'_i R*/E*, moved towards the rigid-partner geometry R* by the harder partner's weight
         # w): the counter-surface ratio a/ρ_c and the collapse limits' curvature ratio
-        # z_i = R_i/ρ_c − 1 (constants of the pair, so the κ root stays unique)
+        # z_i = R_i/ρ_c − 1 (constants of the pair, so the κ root stays unique); and the radius and
+        # weight of the partner's cap in each body's gap (``cap.py``: 1 for a rigid partner, w for a
+        # harder one; weight 0: the paraboloid)
         self._z = {}
         self._inv_rho_c = {}  # 1/ρ_c of each body (``_body``)
+        self._cap = {}
+        exact = self.coeffs.counter_cap == "exact"
         for law, s_, s_o in ((self.law1, s1, s2), (self.law2, s2, s1)):
             if law is None:
                 continue
@@ -212,12 +216,7 @@ class UnifiedPair:
             w = harder_partner_weight(s_, s_o)
             self._inv_rho_c[id(law)] = (1.0 - w) / rho_h + w / self.R_star
             self._z[id(law)] = curvature_ratio(s_.radius, 1.0 / self._inv_rho_c[id(law)])
-        # weight and radius of the partner's cap in each body's gap (``cap.py``; weight 0: paraboloid)
-        self._cap = {}
-        for law, s_, s_o in ((self.law1, s1, s2), (self.law2, s2, s1)):
-            if law is not None:
-                w = 1.0 if s_o.is_rigid else harder_partner_weight(s_, s_o)
-                self._cap[id(law)] = (s_o.radius, w if self.coeffs.counter_cap == "exact" else 0.0)
+            self._cap[id(law)] = (s_o.radius, (1.0 if s_o.is_rigid else w) if exact else 0.0)
 
     # ------------------------------------------------------------------ body responses
     def _body(self, law: BodyLaw, a, k, R, pressure_only: bool = False) -> BodyResponse:
