@@ -10,8 +10,10 @@ most parameters through a few per-point quantities (``model.levels``):
     ln H̄ = ln H̄_hs − softplus(k ln r)/k,  ln c² = ln c²_hs + w_c (ln c²_c − ln c²_hs)
 
 with r = H̄_hs/H̄_c, w = σ(k ln r), w_c = σ(k_c (ln r + s_c)); the counter-surface terms multiply
-H̄_hs and c²_hs by exp(q s(u)), so ∂ln H̄_hs/∂q_H = ∂ln c²_hs/∂q_c = s(u). Their derivatives are written
-out here, so a column costs a few array operations instead of an evaluation of the model:
+H̄_hs and c²_hs by exp(q s(u)), so ∂ln H̄_hs/∂q_H = ∂ln c²_hs/∂q_c = s(u) (their Level III values,
+fitted at the conformity ζ = 0 and 1 when they change with it: s_l (1 − ζ) s(u) and s_l ζ s(u)).
+Their derivatives are written out here, so a column costs a few array operations instead of an
+evaluation of the model:
 
     ∂ln H̄/∂ln H̄_hs = 1 − w,  ∂ln H̄/∂ln H̄_c = w,  ∂ln H̄/∂ln k = softplus(k ln r)/k − w ln r,
     ∂ln c²/∂ln c²_hs = 1 − w_c,  ∂ln c²/∂ln c²_c = w_c,
@@ -39,7 +41,14 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import Coefficients
-from .forms import X_C2, counter_surface_at, exponent_slope_at, flow_log_slope_at, point_inputs
+from .forms import (
+    X_C2,
+    counter_surface_at,
+    exponent_slope_at,
+    flow_log_slope_at,
+    point_inputs,
+    raw_curvature_ratio,
+)
 
 __all__ = ["residual_jacobian"]
 
@@ -80,7 +89,7 @@ def fd_step(x: float, lo: float, hi: float) -> float:
 class _Parts:
     """The per-point quantities of the module docstring at one coefficient set."""
 
-    def __init__(self, ds, co: Coefficients, tied: bool):
+    def __init__(self, ds, co: Coefficients, tied: bool, conformity: tuple[bool, bool] = (False, False)):
         n, _, Lam, elastic, y, z = point_inputs(ds, co)
         self.n, self.y, self.z, self.elastic = n, y, z, elastic
         lam1, lam3 = co.Lambda_I, co.Lambda_III
@@ -109,9 +118,15 @@ class _Parts:
         self.shape_H = self._shape_sum(co.H_bar_shape, co.H_bar_shape_n)
         self.shape_c = self._shape_sum(co.c2_shape, co.c2_shape_n)
         self.su = counter_surface_at(ds, co)  # s(u) of the counter-surface terms
+        z_raw = raw_curvature_ratio(ds)
+        self.zeta = z_raw / (1.0 + z_raw)  # conformity ζ of the pressing surface
+        # the Level III counter-surface values are fitted at ζ = 0 and 1 (q_III, q_III + q_ζ)
+        self.conformity, self.conformity_c2 = conformity
         H_hs, c_hs = H_q * self.fH, c_q * self.fc
         if co.has_counter_surface:
             (qH, dqH), (qc, dqc) = co.counter_by_level(s)
+            zH, zc = co.counter_conformity(z_raw)
+            qH, qc, dqH, dqc = qH + zH * s, qc + zc * s, dqH + zH, dqc + zc
             H_hs, c_hs = H_hs * np.exp(qH * self.su), c_hs * np.exp(qc * self.su)
             # their level weight moves with Λ like the finite-size factors' (d ln/d ln Λ)
             self.lfH = self.lfH + dqH * ds_l * self.su
@@ -288,13 +303,18 @@ def _log_derivatives(parts: _Parts, name: str, co: Coefficients):
         return dp, dc
     if name in ("counter_H", "counter_H3"):  # ln H̄_hs (and the Hertz p_m of elastic points)
         # move by s(u), by the level weight's share when the terms depend on the level
-        lev = parts.s if name == "counter_H3" else (1.0 - parts.s if co.counter_H_bar_plastic is not None
-                                                     else 1.0)
+        lev = parts.s * (1.0 - parts.zeta if parts.conformity else 1.0) if name == "counter_H3" else (
+            1.0 - parts.s if co.counter_H_bar_plastic is not None else 1.0)
         g = np.where(parts.pos, lev * parts.su, 0.0)
         return np.where(parts.elastic, lev * parts.su, parts.A * g), parts.CcH * g
+    if name == "counter_H31":  # the Level III value at ζ = 1: ln H̄_hs moves by s_l ζ s(u)
+        g = np.where(parts.pos, parts.s * parts.zeta * parts.su, 0.0)
+        return parts.A * g, parts.CcH * g
+    if name == "counter_c231":
+        return zero, parts.Ccc * parts.s * parts.zeta * parts.su
     if name in ("counter_c2", "counter_c23"):
-        lev = parts.s if name == "counter_c23" else (1.0 - parts.s if co.counter_c2_plastic is not None
-                                                      else 1.0)
+        lev = parts.s * (1.0 - parts.zeta if parts.conformity_c2 else 1.0) if name == "counter_c23" else (
+            1.0 - parts.s if co.counter_c2_plastic is not None else 1.0)
         return zero, parts.Ccc * lev * parts.su
     if base in _HALF_SPACE_H:
         g, elastic = parts.half_space_H(_HALF_SPACE_H[base], k, co)
@@ -332,7 +352,8 @@ def residual_jacobian(res, x: np.ndarray) -> np.ndarray:
     blocks = [res.penalty_block(i, co0) for i in range(res.n_penalties)]
     offsets = np.cumsum([n_data] + [b.size for b in blocks])
     active = [i for i in range(res.n_penalties) if res.active(i, co0)]
-    parts = _Parts(res.ds, co0, tied=not any(n.startswith("fsp_") for n in res.form.names))
+    parts = _Parts(res.ds, co0, tied=not any(n.startswith("fsp_") for n in res.form.names),
+                   conformity=("counter_H31" in res.form.names, "counter_c231" in res.form.names))
     sF, sa = res.ds.slope_F, res.ds.slope_a
     for j, name in enumerate(res.form.names):
         h = fd_step(x[j], lo[j], hi[j])

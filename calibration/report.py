@@ -190,12 +190,24 @@ def _chart_model_error(ctx: _Context, plt) -> str:
     return "model_error.png"
 
 
+def _short_names(names: list[str]) -> dict[str, str]:
+    """Each form's name by its fewest trailing '_' parts (two at least) that tell the forms apart
+    ('…_nl_czh'); a name of one part stays whole."""
+    parts = {n: n.split("_") for n in names}
+    for k in range(2, max(len(p) for p in parts.values()) + 1):
+        short = {n: "_".join(p[-k:]) for n, p in parts.items()}
+        if len(set(short.values())) == len(names):
+            return {n: v if v == n else "…_" + v for n, v in short.items()}
+    return {n: n for n in names}
+
+
 def _parameters_chart(ctx: _Context, plt) -> str:
     """Held-out error of F(h) and a(h) (RMS and max over the folds) against the number of
     parameters of every cross-validated form: ``cv_parameters.png``."""
     cal, out = ctx.cal, ctx.out
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
-    for name, cv in cal.cv.items():
+    labels = _short_names(list(cal.cv))
+    for i, (name, cv) in enumerate(cal.cv.items()):
         n = cal.fits[name].form.n_params
         pooled = cv.pooled()
         bold = name == cal.chosen
@@ -203,8 +215,8 @@ def _parameters_chart(ctx: _Context, plt) -> str:
             for q, mk, col in (("F", "o", "tab:blue"), ("a", "s", "tab:orange")):
                 ax.plot(n, 100 * pooled[q][key], mk, color=col, ms=9 if bold else 5,
                         mec="k" if bold else col)
-            ax.annotate(name, (n, 100 * pooled["F"][key]), fontsize=7, xytext=(3, 3),
-                        textcoords="offset points")
+            ax.annotate(labels[name], (n, 100 * pooled["F"][key]), fontsize=7, xytext=(4, 3 + 9 * (i % 3)),
+                        textcoords="offset points")  # staggered: forms of similar size and error
     for ax, t in zip(axes, ("held-out RMS error [%]", "held-out max |error| [%]"), strict=True):
         ax.set_xlabel("parameters of the form")
         ax.set_ylabel(t)

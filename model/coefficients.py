@@ -44,7 +44,13 @@ Functional forms fixed by the schema (symbols of DESIGN §1–2):
   Optional ``H_bar_plastic``, ``c2_plastic``: the fully plastic (Level III) values q_III, and
   q = (1 − s_l) q + s_l q_III with the level weight s_l as for the finite-size factors
   (absent: q_III = q). Against a small rigid sphere c² rises with a/R_i while the body is
-  elastic–plastic and falls once it is fully plastic (pile-up around the indenter);
+  elastic–plastic and falls once it is fully plastic (pile-up around the indenter).
+  Optional ``H_bar_conformity``, ``c2_conformity`` (q_ζ, absent: 0): the Level III values
+  change with the conformity ζ = z/(1 + z) = 1 − ρ_c/R of the pressing surface (0 against a
+  flat, ½ against a rigid sphere of the body's radius, → 1 under a small one),
+  q = (1 − s_l) q + s_l (q_III + q_ζ ζ): at the same a/R_i a fully plastic body is a half space
+  under a small indenter and near collapse under one of its own size; q_III + q_ζ stays in
+  [−2, 2] as well;
 * counter cap (optional ``counter_cap``, absent: ``paraboloid``): ``exact`` adds to the gap a
   body closes the depth of a rigid (or much harder, by its weight w) partner's spherical cap
   beyond its paraboloid, h = (a²/(2ρ) + w e)/c² (``cap.py``); c² was calibrated with it;
@@ -275,6 +281,16 @@ def _counter(d: dict) -> dict:
             raise ValueError(f"coefficients: 'counter_surface.{key}' must lie in "
                              f"[{-COUNTER_BOUND:g}, {COUNTER_BOUND:g}], got {q!r}")
         out[fld] = q
+    for key in ("H_bar_conformity", "c2_conformity"):  # bounded through q_III + q_ζ (below)
+        if key in sec:
+            out[f"counter_{key}"] = _number(sec, key, "counter_surface.")
+    for which in ("H_bar", "c2"):  # the Level III value under a vanishing indenter, q_III + q_ζ
+        q3 = out.get(f"counter_{which}_plastic", out.get(f"counter_{which}", 0.0))
+        q31 = q3 + out.get(f"counter_{which}_conformity", 0.0)
+        if not -COUNTER_BOUND <= q31 <= COUNTER_BOUND:
+            raise ValueError(f"coefficients: 'counter_surface.{which}_plastic' (default '{which}') plus "
+                             f"'{which}_conformity' must lie in [{-COUNTER_BOUND:g}, {COUNTER_BOUND:g}], "
+                             f"got {q31!r}")
     fs = d.get("finite_size")
     if any(out.values()) and isinstance(fs, dict) \
             and fs.get("ratio") != "a_over_R":
@@ -657,6 +673,10 @@ class Coefficients:
     #: their fully plastic (Level III) values, blended by the level weight (None: the same)
     counter_H_bar_plastic: float | None = None
     counter_c2_plastic: float | None = None
+    #: the change of the Level III values with the conformity ζ = z/(1 + z) of the pressing
+    #: surface (0: none)
+    counter_H_bar_conformity: float = 0.0
+    counter_c2_conformity: float = 0.0
     #: two-body interface equation (``unified.py``): coupling λ (0: equal mean pressures alone),
     #: similarity width δ of the fully plastic pressures, and the contact radius a_c/R* and
     #: exponent k of the anchor's move from the Hertz partition to equal strains
@@ -974,7 +994,15 @@ class Coefficients:
     @property
     def has_counter_surface(self) -> bool:
         return bool(self.counter_H_bar or self.counter_c2 or self.counter_H_bar_plastic
-                    or self.counter_c2_plastic)
+                    or self.counter_c2_plastic or self.counter_H_bar_conformity
+                    or self.counter_c2_conformity)
+
+    def counter_conformity(self, z) -> tuple:
+        """q_ζ ζ of H̄ and c² at the curvature ratio z (ζ = z/(1 + z), module docstring): the
+        change of their Level III values, which :meth:`counter_by_level`'s weight s_l multiplies."""
+        z = np.asarray(z, dtype=float)
+        zeta = z / (1.0 + z)
+        return self.counter_H_bar_conformity * zeta, self.counter_c2_conformity * zeta
 
     def counter_by_level(self, s_l):
         """Counter-surface coefficients (q_H, q_c) at level weight ``s_l``: (1 − s_l) q + s_l q_III
@@ -989,7 +1017,9 @@ class Coefficients:
     def _counter_section(self) -> dict:
         sec = {"H_bar": self.counter_H_bar, "c2": self.counter_c2}
         for key, v in (("H_bar_plastic", self.counter_H_bar_plastic),
-                       ("c2_plastic", self.counter_c2_plastic)):
+                       ("c2_plastic", self.counter_c2_plastic),
+                       ("H_bar_conformity", self.counter_H_bar_conformity or None),
+                       ("c2_conformity", self.counter_c2_conformity or None)):
             if v is not None:
                 sec[key] = v
         return sec

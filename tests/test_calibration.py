@@ -357,3 +357,12 @@ def test_monotonicity_checks_on_worker_processes_match_the_serial_ones(monkeypat
         parallel = check.check_all(co, mats, pool)
     assert [c.label for c in serial] == [p[0] for p in pairs]
     assert parallel == serial
+
+
+def test_chart_labels_are_the_shortest_distinct_tails_of_the_form_names():
+    from spherecontact.calibration.report import _short_names
+
+    names = ["seed", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl_czh",
+             "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl_cz"]
+    assert list(_short_names(names).values()) == ["seed", "…_zn_nl", "…_nl_czh", "…_nl_cz"]
+    assert _short_names(["a_b_c", "x_b_c"]) == {"a_b_c": "a_b_c", "x_b_c": "x_b_c"}  # only whole names differ

@@ -198,8 +198,8 @@ def test_two_body_stiffness_and_table_with_the_new_terms(ratio, s2):
 
 def test_new_forms_are_candidates_and_write_the_new_keys():
     # the x·n terms are in every candidate that grows the representative strain
-    assert {"smooth2_fs2_xn2n_x2_g_csl_w1_sn_nl",
-            "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl"} <= set(CANDIDATES)
+    assert {"smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl", "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl_czh",
+            "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl_cz"} <= set(CANDIDATES)
     assert all(FORMS[n].n_collapse_xnH >= 1 for n in CANDIDATES if n.endswith("_g"))
     assert all(FORMS[n].n_collapse_xnH >= 1 for n in CANDIDATES if "_xn" in n)
     base, xn, xnw = FORMS["smooth2_fs2"], FORMS["smooth2_fs2_xn"], FORMS["smooth2_fs2_xnw"]
