@@ -184,6 +184,8 @@ class Form:
             **({"strain_spread": self.strain_spread} if self.strain_spread else {}),
             # c² of the data is the gap over h with the rigid sphere's exact cap (``dataset``)
             "counter_cap": "exact",
+            # a pair's less plastic body under its partner's flattened pressure (``model/profile.py``)
+            "pressure_profile": "flattened",
             "Lambda_I": lam1,
             "Lambda_III": lam1 * math.exp(v["ln_Lambda_III_over_I"]),
             "H_bar_III": {"prefactor": v["H_III"], "exp_poly": seq("H_III_n", self.n_III_H)},
@@ -294,7 +296,8 @@ def _unchecked(d: dict) -> Coefficients:
         counter_c2_plastic=d.get("counter_surface", {}).get("c2_plastic"),
         counter_H_bar_conformity=d.get("counter_surface", {}).get("H_bar_conformity", 0.0),
         counter_c2_conformity=d.get("counter_surface", {}).get("c2_conformity", 0.0),
-        counter_cap=d.get("counter_cap", "paraboloid"), source=d["source"],
+        counter_cap=d.get("counter_cap", "paraboloid"),
+        pressure_profile=d.get("pressure_profile", "hertz"), source=d["source"],
         schema_version=d["schema_version"])
 
 

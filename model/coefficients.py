@@ -118,6 +118,8 @@ Z_VARIABLES = ("z", "ln(1+z)")
 EXPONENT_METHODS = ("secant_loglog", "local_secant")
 #: shape of a rigid partner's surface in the gap a body closes (``counter_cap``, ``cap.py``)
 COUNTER_CAPS = ("paraboloid", "exact")
+#: contact pressure profile a less plastic body of a pair is loaded by (``profile.py``)
+PRESSURE_PROFILES = ("hertz", "flattened")
 #: allowed ranges of the ``local_secant`` exponent's window factor and cap
 EXPONENT_WINDOW_RANGE = (1.5, 10.0)
 EXPONENT_CAP_RANGE = (0.1, 2.0)
@@ -194,7 +196,7 @@ LITERATURE: dict = {
 SPREAD_MAX = 2.0
 
 _OPTIONAL_TOP_KEYS = ("beta_growth", "strain_spread", "interface", "counter_surface", "counter_cap",
-                      "unloading")
+                      "pressure_profile", "unloading")
 
 #: bound of the counter-surface coefficients: |q| ≤ 2 keeps d ln F/d ln a and d ln h/d ln a
 #: above 2 − |q|/2 ≥ 1 from these terms (ds/d ln u ≤ ½)
@@ -686,6 +688,8 @@ class Coefficients:
     interface_exponent: float = 4.0
     #: the rigid partner's cap in h: "paraboloid" (a²/(2ρ) alone) or "exact" (``cap.py``)
     counter_cap: str = "paraboloid"
+    #: the pressure profile of a pair's less plastic body: "hertz" or "flattened" (``profile.py``)
+    pressure_profile: str = "hertz"
     #: unloading law (``unloading.py``); the default is Thornton (1997)
     unloading: UnloadingCoefficients = field(default_factory=UnloadingCoefficients)
     source: str = "literature"
@@ -843,6 +847,8 @@ class Coefficients:
             **interface,
             **counter,
             counter_cap=counter_cap,
+            pressure_profile=(_choice(d, "pressure_profile", "", PRESSURE_PROFILES)
+                              if "pressure_profile" in d else "hertz"),
             **unloading,
             source=source,
             schema_version=version,
@@ -866,6 +872,7 @@ class Coefficients:
                if self.interface_coupling else {}),
             **({"counter_surface": self._counter_section()} if self.has_counter_surface else {}),
             **({"counter_cap": self.counter_cap} if self.counter_cap != "paraboloid" else {}),
+            **({"pressure_profile": self.pressure_profile} if self.pressure_profile != "hertz" else {}),
             **({"unloading": self.unloading.to_dict()}
                if self.unloading != UnloadingCoefficients() else {}),
             "Lambda_I": self.Lambda_I,

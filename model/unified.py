@@ -64,6 +64,7 @@ import numpy as np
 
 from .cap import cap_gap_factor
 from .coefficients import Coefficients, default_coefficients
+from .profile import profile_factor
 from .roots import solve_increasing
 from .single import BodyLaw, BodyResponse, curvature_ratio
 from .sphere import Sphere
@@ -217,12 +218,33 @@ class UnifiedPair:
             self._inv_rho_c[id(law)] = (1.0 - w) / rho_h + w / self.R_star
             self._z[id(law)] = curvature_ratio(s_.radius, 1.0 / self._inv_rho_c[id(law)])
             self._cap[id(law)] = (s_o.radius, (1.0 if s_o.is_rigid else w) if exact else 0.0)
+        # the partner whose pressure profile each body is loaded by (``profile.py``; a/R ratio only:
+        # the factor depends on a alone, which the y slot of the slopes carries)
+        self._profile, self._levels_c = {}, {}
+        if self.mode == "general" and self.coeffs.pressure_profile == "flattened" and not self._ratio_rho:
+            self._profile = {id(self.law1): self.law2, id(self.law2): self.law1}
 
     # ------------------------------------------------------------------ body responses
     def _body(self, law: BodyLaw, a, k, R, pressure_only: bool = False) -> BodyResponse:
         x = a * k
         y = x if self._ratio_rho else a / R
-        return law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only)
+        r = law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only)
+        other = self._profile.get(id(law))
+        if other is None:
+            return r
+        ln_q, dln_q = profile_factor(*self._level_at_c(law, a), *self._level_at_c(other, a))
+        return r._replace(p_m=r.p_m * np.exp(ln_q), dlnp_dlny=r.dlnp_dlny + dln_q)
+
+    def _level_at_c(self, law: BodyLaw, a):
+        """The body's level weight and its slope at a/ρ_c (``BodyLaw.level_state_at``), kept for the
+        last a of each body: the κ solve reads both bodies at one a, each needing the two."""
+        a = np.asarray(a, dtype=float)
+        hit = self._levels_c.get(id(law))
+        if hit is not None and hit[0].shape == a.shape and np.array_equal(hit[0], a):
+            return hit[1]
+        v = law.level_state_at(a * self._inv_rho_c[id(law)])
+        self._levels_c[id(law)] = (a.copy(), v)
+        return v
 
     def _g(self, a, u, C=0.0, uA=0.0):
         """g = ln p_1 − ln p_2 + C (u − u_A) at (a, u), its u-derivative, and both responses

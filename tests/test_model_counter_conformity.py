@@ -18,15 +18,9 @@ from test_model_counter_surface import check_predict_and_jacobian, check_rise_be
 from spherecontact.calibration.dataset import build_dataset
 from spherecontact.calibration.forms import FORMS, Form
 from spherecontact.calibration.synthetic import model_result
-from spherecontact.model import (
-    CalibrationRangeWarning,
-    Material,
-    Sphere,
-    contact,
-    default_coefficients,
-    levels,
-)
+from spherecontact.model import CalibrationRangeWarning, Material, Sphere, contact, default_coefficients
 from spherecontact.model.coefficients import COUNTER_BOUND, Coefficients
+from spherecontact.model.levels import counter_surface, level_weight
 from spherecontact.model.single import BodyLaw
 
 LUDWIK = Material(E=2000.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3)
@@ -67,8 +61,8 @@ def test_pressure_under_a_rigid_sphere_moves_by_the_level_weighted_factor():
         x = y * (1.0 + z)  # a/ρ
         r0 = BodyLaw(LUDWIK, co0).response(x, y, z)
         r1 = BodyLaw(LUDWIK, co1).response(x, y, z)
-        s_l = levels.level_weight(r0.Lambda, co0)[0]
-        su = levels.counter_surface(x, y)[0]
+        s_l = level_weight(r0.Lambda, co0)[0]
+        su = counter_surface(x, y)[0]
         np.testing.assert_allclose(r1.p_m / r0.p_m, np.exp(s_l * qz * z / (1.0 + z) * su), rtol=1e-12)
         np.testing.assert_array_equal(r1.c2, r0.c2)
         seen = max(seen, float(np.max(s_l * su)))
