@@ -376,7 +376,7 @@ class BodyLaw:
         return self._piece(Lam, eps, y, x)
 
     def response(self, x, y=None, z: float = 0.0, xc=None,
-                 pressure_only: bool = False) -> BodyResponse:
+                 pressure_only: bool = False, level_c=None) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
         ``z`` the curvature ratio of the collapse limits (a constant of the pair,
         :func:`curvature_ratio`); ``xc`` the contact radius over the body's Hertz relative
@@ -389,7 +389,8 @@ class BodyLaw:
         weight that moves the terms' coefficients (``counter_by_level``) is read at xc as well, for
         the same reason: read at x it left 27 of 300 random plastic pairs without a consistent root
         from h/R ≈ 0.32 on. ``pressure_only``: p_m and its slopes alone (what the κ solve reads;
-        c², its slopes and the piece are None), without the c² terms' cost."""
+        c², its slopes and the piece are None), without the c² terms' cost. ``level_c``: the
+        level weight and its slope at ``xc`` (:meth:`level_state_at`) when the caller has them."""
         mat, co = self.material, self.coeffs
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
@@ -439,7 +440,7 @@ class BodyLaw:
             else:  # u = xc − y moves with a only: every slope in the y slot, the level weight too
                 su, su_x, su_y = counter_surface(np.asarray(xc, dtype=float), y)
                 su_x, su_y = 0.0, su_x + su_y
-                s_c, ds_c = self.level_state_at(np.asarray(xc, dtype=float))
+                s_c, ds_c = self.level_state_at(np.asarray(xc, dtype=float)) if level_c is None else level_c
                 lev_x, lev_y = 0.0, ds_c
             (qH, dqH), (qc, dqc) = co.counter_by_level(s_c)  # q(s), dq/ds
             zH, zc = co.counter_conformity(z)  # + s_l q_ζ ζ (ζ: a constant of the pair)

@@ -228,11 +228,12 @@ class UnifiedPair:
     def _body(self, law: BodyLaw, a, k, R, pressure_only: bool = False) -> BodyResponse:
         x = a * k
         y = x if self._ratio_rho else a / R
-        r = law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only)
         other = self._profile.get(id(law))
         if other is None:
-            return r
-        ln_q, dln_q = profile_factor(*self._level_at_c(law, a), *self._level_at_c(other, a))
+            return law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only)
+        own = self._level_at_c(law, a)  # the response reads it too (counter-surface weight)
+        r = law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only, own)
+        ln_q, dln_q = profile_factor(*own, *self._level_at_c(other, a))
         return r._replace(p_m=r.p_m * np.exp(ln_q), dlnp_dlny=r.dlnp_dlny + dln_q)
 
     def _level_at_c(self, law: BodyLaw, a):
