@@ -420,10 +420,7 @@ def predict(ds: Dataset, coeffs: Coefficients) -> tuple[np.ndarray, np.ndarray]:
     gH = 1.0
     if co.has_counter_surface:
         su = counter_surface_at(ds, co)
-        s_l = levels.level_weight(Lam, co)[0]
-        (qH, _), (qc, _) = co.counter_by_level(s_l)
-        zH, zc = co.counter_conformity(raw_curvature_ratio(ds))
-        qH, qc = qH + zH * s_l, qc + zc * s_l
+        (qH, _), (qc, _) = co.counter_by_level(levels.level_weight(Lam, co)[0], raw_curvature_ratio(ds))
         gH = np.exp(qH * su)
         H, c = H * gH, c * np.exp(qc * su)
     if co.has_collapse:

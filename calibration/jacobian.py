@@ -124,9 +124,7 @@ class _Parts:
         self.conformity, self.conformity_c2 = conformity
         H_hs, c_hs = H_q * self.fH, c_q * self.fc
         if co.has_counter_surface:
-            (qH, dqH), (qc, dqc) = co.counter_by_level(s)
-            zH, zc = co.counter_conformity(z_raw)
-            qH, qc, dqH, dqc = qH + zH * s, qc + zc * s, dqH + zH, dqc + zc
+            (qH, dqH), (qc, dqc) = co.counter_by_level(s, z_raw)
             H_hs, c_hs = H_hs * np.exp(qH * self.su), c_hs * np.exp(qc * self.su)
             # their level weight moves with Λ like the finite-size factors' (d ln/d ln Λ)
             self.lfH = self.lfH + dqH * ds_l * self.su

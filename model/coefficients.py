@@ -376,8 +376,11 @@ def _section(d: dict, key: str) -> dict:
     return v
 
 
-def _choice(d: dict, key: str, where: str, allowed: tuple[str, ...]) -> str:
+def _choice(d: dict, key: str, where: str, allowed: tuple[str, ...], default: str | None = None) -> str:
+    """``d[key]``, one of ``allowed``; ``default`` when the key is absent (None: required)."""
     if key not in d:
+        if default is not None:
+            return default
         raise ValueError(f"coefficients: missing key '{where}{key}'")
     v = d[key]
     if v not in allowed:
@@ -727,7 +730,8 @@ class Coefficients:
                              f"got {spread!r}")
         interface = _interface(d)
         counter = _counter(d)
-        counter_cap = _choice(d, "counter_cap", "", COUNTER_CAPS) if "counter_cap" in d else "paraboloid"
+        counter_cap = _choice(d, "counter_cap", "", COUNTER_CAPS, default="paraboloid")
+        profile = _choice(d, "pressure_profile", "", PRESSURE_PROFILES, default="hertz")
         unloading = _unloading(d)
         lam1 = _number(d, "Lambda_I", "")
         lam3 = _number(d, "Lambda_III", "")
@@ -847,8 +851,7 @@ class Coefficients:
             **interface,
             **counter,
             counter_cap=counter_cap,
-            pressure_profile=(_choice(d, "pressure_profile", "", PRESSURE_PROFILES)
-                              if "pressure_profile" in d else "hertz"),
+            pressure_profile=profile,
             **unloading,
             source=source,
             schema_version=version,
@@ -1004,21 +1007,17 @@ class Coefficients:
                     or self.counter_c2_plastic or self.counter_H_bar_conformity
                     or self.counter_c2_conformity)
 
-    def counter_conformity(self, z) -> tuple:
-        """q_ζ ζ of H̄ and c² at the curvature ratio z (ζ = z/(1 + z), module docstring): the
-        change of their Level III values, which :meth:`counter_by_level`'s weight s_l multiplies."""
+    def counter_by_level(self, s_l, z=0.0):
+        """Counter-surface coefficients (q_H, q_c) at level weight ``s_l`` and curvature ratio ``z``
+        of the pressing surface: (1 − s_l) q + s_l (q_III + q_ζ ζ), ζ = z/(1 + z) (module docstring;
+        q_III defaults to q, q_ζ to 0), and their derivatives in s_l."""
         z = np.asarray(z, dtype=float)
         zeta = z / (1.0 + z)
-        return self.counter_H_bar_conformity * zeta, self.counter_c2_conformity * zeta
-
-    def counter_by_level(self, s_l):
-        """Counter-surface coefficients (q_H, q_c) at level weight ``s_l``: (1 − s_l) q + s_l q_III
-        (module docstring; q_III defaults to q), and their derivatives in s_l."""
         out = []
-        for q, q3 in ((self.counter_H_bar, self.counter_H_bar_plastic),
-                      (self.counter_c2, self.counter_c2_plastic)):
+        for q, q3, qz in ((self.counter_H_bar, self.counter_H_bar_plastic, self.counter_H_bar_conformity),
+                          (self.counter_c2, self.counter_c2_plastic, self.counter_c2_conformity)):
             d = 0.0 if q3 is None else q3 - q
-            out.append((q + d * s_l, d))
+            out.append((q + d * s_l + qz * zeta * s_l, d + qz * zeta))
         return out
 
     def _counter_section(self) -> dict:

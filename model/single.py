@@ -442,9 +442,7 @@ class BodyLaw:
                 su_x, su_y = 0.0, su_x + su_y
                 s_c, ds_c = self.level_state_at(np.asarray(xc, dtype=float)) if level_c is None else level_c
                 lev_x, lev_y = 0.0, ds_c
-            (qH, dqH), (qc, dqc) = co.counter_by_level(s_c)  # q(s), dq/ds
-            zH, zc = co.counter_conformity(z)  # + s_l q_ζ ζ (ζ: a constant of the pair)
-            qH, qc, dqH, dqc = qH + zH * s_c, qc + zc * s_c, dqH + zH, dqc + zc
+            (qH, dqH), (qc, dqc) = co.counter_by_level(s_c, z)  # q(s), dq/ds (z: a constant of the pair)
             p = p * np.exp(qH * su)
             dp_x, dp_y = dp_x + qH * su_x + dqH * su * lev_x, dp_y + qH * su_y + dqH * su * lev_y
             if with_c2:
