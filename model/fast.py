@@ -64,6 +64,9 @@ _KINK_POINTS = 1024  # points per pass of the kink search, shared by the kinks (
 _KINKS_PER_STEP = 8  # searches of one grid interval for further piece changes after the first
 _PROBES = (0.21, 0.5, 0.79)  # error probes: fractions of every interval in ln a
 _SAFETY = 2.0      # error bound = safety × largest error found at the probe points
+#: a change of u = ln(ρ_2/ρ_1) between neighbouring nodes above this is a jump of the κ root
+#: (nodes ≤ 0.02 apart in ln a move u by ≤ 0.05 elsewhere; across a jump by several units)
+_U_JUMP = 0.5
 _BELOW = 2.0       # grid steps of the grid's bottom below the Hertz radius of h_min
 _WIDER = 0.7       # ln a of the grid's top above the Hertz radius of h_max
 _EXTEND = 8        # grid steps added at a time where the grid falls short of an end
@@ -139,7 +142,8 @@ class ContactLaw:
     s1, s2 : the spheres.
     h_max : largest approach tabulated; default 0.5·min(R_1, R_2) (R* for a flat partner),
         at most the end of the model's domain (``UnifiedPair.domain``; a larger h_max raises
-        ValueError naming it and the allowed range, as do approaches beyond it later).
+        ValueError naming it and the allowed range, as do approaches beyond it later), and at
+        most ``h_limit``.
     h_min : smallest approach tabulated; default 1e-10·R*. Below it and above h_max
         the exact solve is used.
     coeffs : coefficient set; default ``data/coefficients.json``.
@@ -151,6 +155,10 @@ class ContactLaw:
         and ``unloading_F`` (F on unloading branches, relative to F_max; target ``UNLOADING_RTOL``).
     setup_time : seconds spent building the table.
     nodes : number of table nodes; ``kinks``: the approaches h where the model has kinks.
+    h_limit : approach of the last grid node before the κ root jumps (two deformable spheres
+        at their plastic limit, where h(a) is nearly vertical: ``unified.py``), inf if it does
+        not; the table ends there and the exact solve, which follows the branch, takes the
+        approaches beyond (slower: 8–10 ms a contact for the pairs of the tests).
     unloading_table : plain arrays at the table's nodes for the unloading branch of a peak
         there (``unloading.py``): ``ln_h`` (the nodes, ln of the peak approach), ``recovery``
         δ_e/h_max (1: an elastic peak, which returns along the loading curve), ``m`` (exponent
@@ -193,6 +201,8 @@ class ContactLaw:
             raise ValueError(f"rtol must be > 0, got {rtol!r}")
         self.h_min, self.h_max, self.rtol = float(h_min), float(h_max), float(rtol)
         reg, st_reg = self._regular_grid()
+        self.h_limit = self._plastic_limit(st_reg)
+        self.h_max = min(self.h_max, self.h_limit)
         self._lnX = self._ends(reg, st_reg)
         kinks = self._find_kinks(reg, st_reg)
         self._build(reg, st_reg, kinks)
@@ -258,6 +268,17 @@ class ContactLaw:
                          f"(h = {st.h[0]:.6g} … {st.h[-1]:.6g} over contact radii "
                          f"{Rs * math.exp(reg[0]):.6g} … {Rs * math.exp(reg[-1]):.6g}, "
                          f"h_min = {self.h_min:.6g}, h_max = {self.h_max:.6g})")
+
+    def _plastic_limit(self, st: UnifiedState) -> float:
+        """The approach of the last grid node before the κ root first jumps (a pair at its
+        plastic limit: h(a) nearly vertical, ``unified.py``), inf if it does not. A table in a
+        cannot follow the branch there; approaches beyond it take the exact solve, which does."""
+        u = self._u_of(st)
+        if u is None:
+            return math.inf
+        j = np.nonzero(np.abs(np.diff(u)) > _U_JUMP)[0]
+        j = j[st.h[j] > self.h_min]
+        return float(st.h[j[0]]) if j.size else math.inf
 
     def _ends(self, reg: np.ndarray, st: UnifiedState) -> tuple[float, float]:
         """ln(a/R*) of h_min and h_max: inverse cubic Hermite of the grid (ln a against ln h,

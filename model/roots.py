@@ -31,6 +31,7 @@ def solve_increasing(
     max_step: float = 4.0,
     maxiter: int = 200,
     describe: Callable[[np.ndarray], str] | None = None,
+    strict: bool = True,
 ) -> np.ndarray:
     """Solve f(x) = 0 element-wise for f increasing in x.
 
@@ -45,6 +46,8 @@ def solve_increasing(
     maxiter : iteration limit; ValueError if some elements have not converged.
     describe : ``describe(idx) -> str`` names the inputs of the elements ``idx`` in the
         ValueError raised when they do not converge or f is NaN there.
+    strict : False: elements that have not converged after ``maxiter`` iterations are NaN
+        in the result instead of raising (a NaN f still raises).
 
     Returns
     -------
@@ -104,6 +107,9 @@ def solve_increasing(
         if idx.size == 0:
             return x
         fx, dx = f(x[idx], idx)
+    if not strict:
+        x[idx] = np.nan
+        return x
     raise ValueError(_failure(f"root solve did not converge for {idx.size} of {n} elements", idx,
                               describe))
 

@@ -42,6 +42,12 @@ radii: ρ_1 = ρ_2 = 2R*) and a rigid partner (ρ = R* for the deformable body).
 The stiffness dF/dh is exact: implicit differentiation of g(u; a) = 0 gives
 du/d ln a = −(∂g/∂ln a)/(∂g/∂u), and dF/dh = (dF/d ln a)/(dh/d ln a).
 
+The plastic limit: where both bodies are (nearly) fully plastic their pressures hardly depend
+on u, g is flat in u over a range, and the root u(a) jumps (h(a) nearly vertical, F nearly
+constant: the approach moves from one body to the other at one contact radius). The inversion
+h → a then fails or lands on another root; :meth:`UnifiedPair.state_from_h` solves those
+approaches along the branch in u instead (a(u) from g(a, u) = 0, then u from h).
+
 Domain (:attr:`UnifiedPair.domain`): h(a) and F(a) rise for every a > 0 (the large-
 deformation terms are continued to constants beyond their fitted range, ``levels.py``), but
 geometry bounds the approach: each deformable sphere's own approach stays within its radius,
@@ -107,8 +113,14 @@ _PIECES = 1 << 32
 #: the inversion h → a is exact to ~1e-14)
 _DOMAIN_SLACK = 1.0 + 1e-9
 #: largest |h1 + h2 − h|/h a state from the inversion may have (it is ~1e-14 where the κ root is
-#: unique; a larger gap means the root jumped: ``state_from_h`` raises instead of returning it)
+#: unique; a larger gap means the root jumped: ``state_from_h`` then solves the branch in u, and
+#: raises if that state misses h too)
 _CONSISTENT = 1e-8
+#: iterations of the inversion in a before the branch solve in u takes over (it needs ≤ 6
+#: evaluations for 60 random plastic pairs where the κ root is unique)
+_INVERT_MAXITER = 40
+#: step in u of the difference quotient d ln h/du along the branch (:meth:`UnifiedPair._invert_in_u`)
+_DU = 1e-6
 #: sections per pass and passes of the search for the domain end of a general pair
 _DOMAIN_SECTIONS = 64
 _DOMAIN_PASSES = 6
@@ -443,8 +455,63 @@ class UnifiedPair:
             t_w[idx], u_w[idx], du_w[idx] = t, u, du
             return np.log(s.h) - lnh[idx], s.dlnh_dlna
 
-        t = solve_increasing(f, t0, step=0.5, tol=1e-14, describe=describe)
-        return np.exp(t), (self.solve_u(np.exp(t), guess(t, slice(None))) if with_u else None)
+        t = solve_increasing(f, t0, step=0.5, tol=1e-14, describe=describe, strict=False,
+                             maxiter=_INVERT_MAXITER)
+        a = np.exp(t)
+        failed = ~np.isfinite(t)
+        if not with_u and not failed.any():
+            return a, None
+        u = np.full(h.shape, np.nan)
+        ok = ~failed
+        u[ok] = self.solve_u(a[ok], guess(t[ok], ok))
+        if failed.any():
+            a[failed], u[failed] = self._invert_in_u(h[failed], np.exp(t_w[failed]))
+        return a, (u if with_u else None)
+
+    def _invert_in_u(self, h, a0):
+        """(a, u) for approaches h where the inversion in a fails: where both bodies are (nearly)
+        fully plastic their pressures hardly depend on the partition, g(u; a) is flat in u over a
+        range and the κ root jumps with a (a near-vertical stretch of h(a), the load nearly
+        constant while h grows: the pair's plastic limit). There the branch is solved the other
+        way round: a(u) from g(a, u) = 0 (rising in ln a at fixed u: the pressure difference the
+        bodies' sizes make), then u with h(a(u), u) = h (h changes monotonically along the
+        branch as the approach moves from one body to the other). ``a0``: start of the first
+        a-solve. ValueError if either solve does not converge."""
+        lnh = np.log(h)
+        t_a = np.log(np.asarray(a0, dtype=float)).copy()
+
+        def a_of(u, idx):
+            def g(t, j):
+                a, uu = np.exp(t), u[j]
+                C, dC, uA, duA = self._coupling(a)
+                gv, _, r1, r2 = self._g(a, uu, C, uA)
+                B1, B2 = r1.dlnp_dlnx + r1.dlnp_dlny, r2.dlnp_dlnx + r2.dlnp_dlny
+                return gv, B1 - B2 + dC * (uu - uA) - C * duA
+
+            def describe(j):
+                return f"pressure balance in a at u = {_values(u[j])} ({self.describe()})"
+            return solve_increasing(g, t_a[idx], step=0.05, tol=1e-14, describe=describe)
+
+        def ln_h(u, idx):  # ln h along the branch and d ln h/du
+            t = a_of(u, idx)
+            t_a[idx] = t
+            lnh_u = np.log(self._two_body_state(np.exp(t), u)[0].h)
+            lnh_du = np.log(self._two_body_state(np.exp(a_of(u + _DU, idx)), u + _DU)[0].h)
+            return lnh_u, (lnh_du - lnh_u) / _DU
+
+        u0 = np.full(h.shape, self._u0)
+        sign = -np.sign(ln_h(u0, np.arange(h.size))[1])  # solved in v = sign·u, along which h falls
+        sign[sign == 0.0] = 1.0
+
+        def f(v, idx):
+            lnh_u, d = ln_h(sign[idx] * v, idx)
+            return lnh[idx] - lnh_u, -sign[idx] * d
+
+        def describe(idx):
+            return f"inversion h -> (a, u) at h = {_values(h[idx])} ({self.describe()})"
+
+        u = sign * solve_increasing(f, sign * u0, step=1.0, tol=1e-13, describe=describe)
+        return np.exp(a_of(u, np.arange(h.size))), u
 
     def a_from_h(self, h) -> np.ndarray:
         """Contact radius for approaches h (1-D, 0 < h ≤ ``domain.h_max``): monotone root of
@@ -460,6 +527,10 @@ class UnifiedPair:
         st = self.state_at_a(a, u)
         h = np.asarray(h, dtype=float)
         off = np.abs(st.h - h) > _CONSISTENT * h
+        if np.any(off) and self.mode == "general":  # the root jumped: the branch solved in u
+            a[off], u[off] = self._invert_in_u(h[off], a[off])
+            st = self.state_at_a(a, u)
+            off = np.abs(st.h - h) > _CONSISTENT * h
         if np.any(off):
             raise ValueError(
                 f"the two-body partition (kappa solve) has no consistent root at h = {_values(h[off])}: "

@@ -34,6 +34,16 @@ def test_non_convergence_is_reported():
                          np.zeros_like(ROOTS), maxiter=3)
 
 
+def test_non_convergence_leaves_nan_when_not_strict():
+    """strict=False: the elements still open after maxiter are NaN, the converged ones exact."""
+    def f(x, idx):  # element 0 converges at once (linear), the others cannot in 3 iterations
+        lin = idx == 0
+        return np.where(lin, x - ROOTS[idx], np.cbrt(x - ROOTS[idx])), np.ones_like(x)
+    x = solve_increasing(f, np.zeros_like(ROOTS), maxiter=3, strict=False)
+    assert x[0] == pytest.approx(ROOTS[0], abs=1e-14)
+    assert np.isnan(x[1:]).sum() >= 1 and np.all(np.isnan(x) | (np.abs(x - ROOTS) < 1e-12))
+
+
 def test_table_of_a_dissimilar_pair_needs_few_kappa_iterations(monkeypatch):
     """The interface-curvature solve over the ~600 table nodes of a steel-aluminium pair: the
     false-position closing step keeps the slowest node under 15 iterations (bisection
