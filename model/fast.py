@@ -64,8 +64,10 @@ _KINK_POINTS = 1024  # points per pass of the kink search, shared by the kinks (
 _KINKS_PER_STEP = 8  # searches of one grid interval for further piece changes after the first
 _PROBES = (0.21, 0.5, 0.79)  # error probes: fractions of every interval in ln a
 _SAFETY = 2.0      # error bound = safety × largest error found at the probe points
-#: a change of u = ln(ρ_2/ρ_1) between neighbouring nodes above this is a jump of the κ root
-#: (nodes ≤ 0.02 apart in ln a move u by ≤ 0.05 elsewhere; across a jump by several units)
+#: a change of u = ln(ρ_2/ρ_1) between neighbouring grid nodes that misses the one predicted by
+#: the nodes' du/d ln a by more than this is a jump of the κ root (the prediction is within 0.2
+#: where u moves by up to 1.5 a node on the way to a pair's plastic limit; a jump misses it by
+#: several units)
 _U_JUMP = 0.5
 _BELOW = 2.0       # grid steps of the grid's bottom below the Hertz radius of h_min
 _WIDER = 0.7       # ln a of the grid's top above the Hertz radius of h_max
@@ -125,6 +127,13 @@ def _sections(width: float, kinks: int) -> int:
     most = max(_KINK_POINTS // kinks, 16)
     passes = math.ceil(math.log(ratio) / math.log(most))
     return min(math.ceil(1.01 * ratio ** (1.0 / passes)), most)
+
+
+def _jumps(lnX: np.ndarray, u: np.ndarray, du: np.ndarray) -> np.ndarray:
+    """Indices j where u(lnX) jumps between nodes j and j + 1: the change misses the trapezoidal
+    prediction from du/d ln a by more than ``_U_JUMP``."""
+    pred = 0.5 * (du[:-1] + du[1:]) * np.diff(lnX)
+    return np.nonzero(np.abs(np.diff(u) - pred) > _U_JUMP)[0]
 
 
 def _log_slopes(st: UnifiedState):
@@ -201,7 +210,7 @@ class ContactLaw:
             raise ValueError(f"rtol must be > 0, got {rtol!r}")
         self.h_min, self.h_max, self.rtol = float(h_min), float(h_max), float(rtol)
         reg, st_reg = self._regular_grid()
-        self.h_limit = self._plastic_limit(st_reg)
+        self.h_limit = self._plastic_limit(reg, st_reg)
         self.h_max = min(self.h_max, self.h_limit)
         self._lnX = self._ends(reg, st_reg)
         kinks = self._find_kinks(reg, st_reg)
@@ -269,14 +278,14 @@ class ContactLaw:
                          f"{Rs * math.exp(reg[0]):.6g} … {Rs * math.exp(reg[-1]):.6g}, "
                          f"h_min = {self.h_min:.6g}, h_max = {self.h_max:.6g})")
 
-    def _plastic_limit(self, st: UnifiedState) -> float:
+    def _plastic_limit(self, reg: np.ndarray, st: UnifiedState) -> float:
         """The approach of the last grid node before the κ root first jumps (a pair at its
         plastic limit: h(a) nearly vertical, ``unified.py``), inf if it does not. A table in a
         cannot follow the branch there; approaches beyond it take the exact solve, which does."""
         u = self._u_of(st)
         if u is None:
             return math.inf
-        j = np.nonzero(np.abs(np.diff(u)) > _U_JUMP)[0]
+        j = _jumps(reg, u, self._u_grid[2])
         j = j[st.h[j] > self.h_min]
         return float(st.h[j[0]]) if j.size else math.inf
 
