@@ -339,6 +339,11 @@ def model_probes(coeffs: Coefficients | None, rng: CalibratedRange, h_over_R_max
         ("extreme pair", f"radius ratio 50, yield ratio 20, E ratio 10 (calibrated up to "
          f"{rng.radius_ratio_max:g}, {rng.yield_ratio_max:g}, {rng.E_ratio_max:g})",
          Sphere(1.0, pp), Sphere(50.0, Material(E=2000.0, nu=0.3, sigma_y=20.0))),
+        ("plastic limit pair", "R₂ = 0.365 R₁, yield ratio 1.47, E ratio 1.56, perfectly plastic: "
+         "the smaller sphere's collapse pressure meets the larger one's indentation pressure near "
+         "h/R₂ 0.42 (R = R₂; model/README.md, Domain)",
+         Sphere(1.0, Material(E=2143.12, nu=0.268349, sigma_y=1.0)),
+         Sphere(0.365052, Material(E=3342.54, nu=0.247789, sigma_y=1.46889))),
     ]
     out = []
     for name, desc, s1, s2 in specs:
