@@ -428,7 +428,9 @@ class UnifiedPair:
     # ------------------------------------------------------------------ inversion h → a
     def _invert(self, h, with_u: bool = True):
         """Contact radius a (and the κ variable u, general mode and ``with_u``; else None) for
-        approaches h > 0 (1-D)."""
+        approaches h > 0 (1-D): a monotone root in ln a with the κ solve inside; approaches it
+        does not converge for within ``_INVERT_MAXITER`` iterations are solved along the branch
+        in u (:meth:`_invert_in_u`)."""
         h = np.asarray(h, dtype=float)
         lnh = np.log(h)
         t0 = 0.5 * (lnh + math.log(self.R_star))  # Hertz: a² = R* h
