@@ -210,7 +210,7 @@ class ContactLaw:
             raise ValueError(f"rtol must be > 0, got {rtol!r}")
         self.h_min, self.h_max, self.rtol = float(h_min), float(h_max), float(rtol)
         reg, st_reg = self._regular_grid()
-        self.h_limit = self._plastic_limit(reg, st_reg)
+        self.h_limit = self._plastic_limit(st_reg)
         self.h_max = min(self.h_max, self.h_limit)
         self._lnX = self._ends(reg, st_reg)
         kinks = self._find_kinks(reg, st_reg)
@@ -278,14 +278,14 @@ class ContactLaw:
                          f"{Rs * math.exp(reg[0]):.6g} … {Rs * math.exp(reg[-1]):.6g}, "
                          f"h_min = {self.h_min:.6g}, h_max = {self.h_max:.6g})")
 
-    def _plastic_limit(self, reg: np.ndarray, st: UnifiedState) -> float:
-        """The approach of the last grid node before the κ root first jumps (a pair at its
-        plastic limit: h(a) nearly vertical, ``unified.py``), inf if it does not. A table in a
-        cannot follow the branch there; approaches beyond it take the exact solve, which does."""
-        u = self._u_of(st)
-        if u is None:
+    def _plastic_limit(self, st: UnifiedState) -> float:
+        """The approach of the last node of the regular grid (``st``, whose u and du/d ln a
+        ``self._u_grid`` holds) before the κ root first jumps (a pair at its plastic limit: h(a)
+        nearly vertical, ``unified.py``), inf if it does not. A table in a cannot follow the
+        branch there; approaches beyond it take the exact solve, which does."""
+        if self._u_grid is None:
             return math.inf
-        j = _jumps(reg, u, self._u_grid[2])
+        j = _jumps(*self._u_grid)
         j = j[st.h[j] > self.h_min]
         return float(st.h[j[0]]) if j.size else math.inf
 

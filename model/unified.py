@@ -399,7 +399,7 @@ class UnifiedPair:
             C, dC, uA, duA = self._coupling(a)
             den = A1 * w2 + A2 * w1 + C
             with np.errstate(divide="ignore", invalid="ignore"):
-                du = np.where(den > 0.0, -(B1 - B2 + dC * (u - uA) - C * duA) / den, 0.0)
+                du = np.where(den > 0.0, -_dg_dlna(B1, B2, u, dC, uA, C, duA) / den, 0.0)
         dlnk1 = w2 * du
         dlnk2 = -w1 * du
         # p_1 = p_2 (λ = 0); with the coupling term the contact pressure is their geometric mean
@@ -461,14 +461,16 @@ class UnifiedPair:
                              maxiter=_INVERT_MAXITER)
         a = np.exp(t)
         failed = ~np.isfinite(t)
-        if not with_u and not failed.any():
-            return a, None
-        u = np.full(h.shape, np.nan)
-        ok = ~failed
-        u[ok] = self.solve_u(a[ok], guess(t[ok], ok))
+        u = None
+        if with_u:
+            u = np.full(h.shape, np.nan)
+            u[~failed] = self.solve_u(a[~failed], guess(t[~failed], ~failed))
         if failed.any():
-            a[failed], u[failed] = self._invert_in_u(h[failed], np.exp(t_w[failed]))
-        return a, (u if with_u else None)
+            a_f, u_f = self._invert_in_u(h[failed], np.exp(t_w[failed]))
+            a[failed] = a_f
+            if with_u:
+                u[failed] = u_f
+        return a, u
 
     def _invert_in_u(self, h, a0):
         """(a, u) for approaches h where the inversion in a fails: where both bodies are (nearly)
@@ -488,7 +490,7 @@ class UnifiedPair:
                 C, dC, uA, duA = self._coupling(a)
                 gv, _, r1, r2 = self._g(a, uu, C, uA)
                 B1, B2 = r1.dlnp_dlnx + r1.dlnp_dlny, r2.dlnp_dlnx + r2.dlnp_dlny
-                return gv, B1 - B2 + dC * (uu - uA) - C * duA
+                return gv, _dg_dlna(B1, B2, uu, dC, uA, C, duA)
 
             def describe(j):
                 return f"pressure balance in a at u = {_values(u[j])} ({self.describe()})"
@@ -624,6 +626,12 @@ class UnifiedPair:
 #: weight moved the counter-surface ratio only; with the collapse limits' z moved too (2026-11-26),
 #: 49.7 / 43.8 / 43.0 % for k = 2 / 4 / 8 (validation runs above 5 %: 5 / 3 / 3)
 HARDER_PARTNER_EXPONENT = 4.0
+
+
+def _dg_dlna(B1, B2, u, dC, uA, C, duA):
+    """∂g/∂ln a at fixed u of the interface equation g = ln p_1 − ln p_2 + C (u − u_A): B_i the
+    bodies' d ln p_i/d ln a at fixed k_i, dC and du_A the coupling's ln a derivatives."""
+    return B1 - B2 + dC * (u - uA) - C * duA
 
 
 def harder_partner_weight(s: Sphere, partner: Sphere) -> float:
