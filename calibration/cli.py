@@ -20,8 +20,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="python -m spherecontact.calibration",
         description="Fit H_bar(Lambda), c2(Lambda), the level boundaries, beta and the "
                     "large-deformation terms to the FE calibration runs; choose the Level II "
-                    "form by leave-one-material-out cross-validation; write the coefficient "
-                    "file and the report.")
+                    "form by cross-validation over five folds of held-out materials; write the "
+                    "coefficient file and the report.")
     p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
     p.add_argument("--out", default="data/coefficients.json", help="coefficient file to write")
     p.add_argument("--report", default="reports/calibration", metavar="DIR",
@@ -33,8 +33,8 @@ def build_parser() -> argparse.ArgumentParser:
                         f"not depend on it (default {DEFAULT_WORKERS})")
     p.add_argument("--fold-nfev", type=int, default=FOLD_NFEV, metavar="N",
                    help="evaluations per cross-validation fold fit, 1-10000 (default "
-                        f"{FOLD_NFEV}; 100 with --fold-tol 1e-8 solves the folds: slower, and the "
-                        "held-out errors it reports are larger, see calibration/README.md)")
+                        f"{FOLD_NFEV}; 100 with --fold-tol 1e-8 solves the folds further: slower, see "
+                        "calibration/README.md)")
     p.add_argument("--fold-tol", type=float, default=FOLD_TOL, metavar="TOL",
                    help=f"stopping tolerance of a fold fit, 1e-15-1e-2 (default {FOLD_TOL:g})")
     p.add_argument("--converged-only", action="store_true",

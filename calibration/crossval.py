@@ -1,17 +1,24 @@
-"""Leave-one-material-out cross-validation of the candidate forms.
+"""Cross-validation of the candidate forms by held-out materials (``FOLDS`` folds).
 
-A fold holds out every run of one material (E/σY, ν, hardening; both scenes, flat and
-rigid sphere), refits the form on the rest and predicts the held-out points. The fold
-fit starts from the full fit (warm start) and is solved to ``FOLD_TOL`` with at most
-``FOLD_NFEV`` iterations. A fold must be solved, not just nudged: the full fit has seen
-the held-out material, and a fold stopped after a few iterations stays near it, which
-flatters the flexible forms (a 32-parameter form scored 2.40 % after 8 iterations and
-2.51 % solved; the 23-parameter forms did not move). With 1e-5 and 30 the scores are within
-0.035 percentage point of those at 1e-6 and 100 iterations on the reference database (the
-seed form 0.07: its folds need more iterations; it is far from the choice).
-Each fold also records how far its coefficient set moved from the full fit, as the change
-of the predicted H̄ and c² over all points (RMS and max): the stability of the fit against
-dropping a material. The folds of all forms are independent tasks (``workers``).
+The materials (E/σY, ν, hardening; both scenes, flat and rigid sphere, of a material go
+together) are dealt in turn, by their sorted labels, into ``FOLDS`` folds; a fold holds out
+every run of its materials, refits the form on the rest and predicts the held-out points.
+The fold fit starts from the full fit (warm start, solved in the shift from it:
+``fit._solve``) and is solved to ``FOLD_TOL`` with at most ``FOLD_NFEV`` iterations.
+
+A fold must move away from the full fit: the full fit has seen the held-out points, and a
+fold that stays at it scores the form's fit, not its prediction. Leaving one material out
+(90 folds of one material each, the scheme until 2026-11-27) did not: the fit's cost valley is
+so flat that removing one material of 90 moved its minimum by 3e-4 of the cost, trf stopped
+at the start in 24 of the first 40 folds of the chosen form and after one or two steps in the
+rest, and the held-out errors were the fit's own (E_cv 1.19 against the in-sample 1.16 %; the
+report's 'shift' column read 0.00 %). Solved (200 evaluations, 1e-10) such a fold took 10 s and
+moved the held-out F error by up to +11 % of itself (0.90 → 0.99 % RMS): 360 folds were out of
+reach. Five folds of 18 materials move every fit (parameters by 0.3–1.5 in ‖Δx‖) in ≤ 30
+iterations; ten folds gave the same choice (``calibration/README.md``, "Cross-validation").
+Each fold also records how far its coefficient set moved from the full fit, as the change of
+the predicted H̄ and c² over all points (RMS and max): the stability of the fit against
+dropping a fifth of the materials. The folds of all forms are independent tasks (``workers``).
 """
 
 from __future__ import annotations
@@ -27,11 +34,13 @@ from .fit import FitResult, errors, fit, rms
 from .forms import Form, predict
 from .workers import Workers
 
-__all__ = ["FOLD_NFEV", "FOLD_TOL", "FoldSolve", "DEFAULT_FOLDS", "Fold", "CVResult", "fold_fit",
-           "fold_tasks", "cross_validate",
+__all__ = ["FOLDS", "FOLD_NFEV", "FOLD_TOL", "FoldSolve", "DEFAULT_FOLDS", "Fold", "CVResult",
+           "material_folds", "fold_fit", "fold_tasks", "cross_validate",
            "cross_validate_many", "REGIMES", "regime_of", "RegimeFold", "regime_fold_fit",
            "regime_tasks", "cross_validate_regimes"]
 
+#: folds of the materials (fewer when the dataset has fewer materials)
+FOLDS = 5
 #: iteration cap of a fold fit (warm-started from the full fit)
 FOLD_NFEV = 30
 #: stopping tolerance of a fold fit (relative change of cost and parameters)
@@ -42,14 +51,10 @@ FOLD_TOL = 1e-5
 class FoldSolve:
     """How far each fold fit is solved: at most ``nfev`` evaluations, tolerance ``tol``.
 
-    The default (30, 1e-5) keeps ``make calibrate`` within a minute; it stops some folds before
-    their minimum, and a fold that stays near the full fit flatters the form (module docstring).
-    Measured on campaign v2 (2026-11-26) against (100, 1e-8): the chosen form's leave-one-material-
-    out score 1.555 → 1.608 %, the next form's 1.636 → 1.642 % (the choice unchanged with the 2 %
-    parsimony margin, by 0.002 points), the held-out regimes' F max up to 16.2 → 22.1 % (the flat
-    partner) and 15.8 → 18.3 % (tabulated curves; 25.3 and 19.6 % at 300 and 1e-10); the chosen
-    form's folds took 117 s against 12 s on two workers. ``--fold-nfev``/``--fold-tol`` of the
-    command line set it."""
+    The default (30, 1e-5) keeps ``make calibrate`` within about a minute; some folds stop at
+    the cap, before their minimum, and a fold that stays nearer the full fit flatters the form
+    (module docstring; ``calibration/README.md``, "Cross-validation", has the figures against
+    solved folds). ``--fold-nfev``/``--fold-tol`` of the command line set it."""
 
     nfev: int = FOLD_NFEV
     tol: float = FOLD_TOL
@@ -67,12 +72,13 @@ DEFAULT_FOLDS = FoldSolve()
 
 @dataclass
 class Fold:
-    group: str
+    group: str                  # the fold's label ("fold k/K")
     n_points: int
     errors: dict[str, np.ndarray]   # held-out relative errors
     params: np.ndarray
     shift_rms: float = 0.0  # RMS and max change of the predicted H̄, c² over all points
     shift_max: float = 0.0  # (fold fit against the full fit): stability of the fit
+    materials: tuple[str, ...] = ()  # the held-out materials
 
 
 @dataclass
@@ -93,26 +99,36 @@ class CVResult:
         return f.group, rms(f.errors[q])
 
 
-def fold_fit(ds: Dataset, form: Form, params: np.ndarray, coeff_dict: dict, group: str,
-             nfev: int = FOLD_NFEV, tol: float = FOLD_TOL) -> Fold:
-    """One fold: refit ``form`` without ``group`` (warm start ``params``), predict ``group``.
+def material_folds(groups: list[str], folds: int = FOLDS) -> list[tuple[str, ...]]:
+    """The materials ``groups`` (sorted labels) dealt in turn into ``folds`` folds (at most one
+    per material)."""
+    k = min(folds, len(groups))
+    return [tuple(groups[i::k]) for i in range(k)]
 
-    ``coeff_dict`` is the full fit's (rounded) coefficient set, against which the shift of
-    the predictions over all points is measured.
-    """
+
+def fold_fit(ds: Dataset, form: Form, params: np.ndarray, coeff_dict: dict, materials: tuple[str, ...],
+             nfev: int = FOLD_NFEV, tol: float = FOLD_TOL, label: str = "") -> Fold:
+    """One fold: refit ``form`` without the runs of ``materials`` (warm start ``params``), predict
+    them. ``coeff_dict`` is the full fit's (rounded) coefficient set, against which the shift of
+    the predictions over all points is measured."""
+    if isinstance(materials, str):
+        raise TypeError(f"materials must be a tuple of material labels, got the string {materials!r}")
     full = Coefficients.from_dict(coeff_dict)
-    train, test = ds.without_group(group), ds.only_group(group)
+    held = set(materials)
+    train = ds.subset([i for i, c in enumerate(ds.curves) if c.group not in held])
+    test = ds.subset([i for i, c in enumerate(ds.curves) if c.group in held])
     r = fit(train, form, start=params, max_nfev=nfev, tol=tol)
     p0, c0 = predict(ds, full)
     p1, c1 = predict(ds, r.coeffs)
     shift = np.concatenate([p1 / p0 - 1.0, c1 / c0 - 1.0])
-    return Fold(group=group, n_points=test.size, errors=errors(test, r.coeffs), params=r.params,
-                shift_rms=rms(shift), shift_max=float(np.max(np.abs(shift))))
+    return Fold(group=label or ", ".join(materials), n_points=test.size, errors=errors(test, r.coeffs),
+                params=r.params, shift_rms=rms(shift), shift_max=float(np.max(np.abs(shift))),
+                materials=tuple(materials))
 
 
 def cross_validate(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV,
                    workers: Workers | None = None) -> CVResult:
-    """Leave-one-material-out CV of ``full.form`` warm-started from ``full``
+    """Cross-validation of ``full.form`` by held-out materials, warm-started from ``full``
     (folds on ``workers`` if given, else in this process)."""
     return cross_validate_many(ds, [full], nfev, workers)[0]
 
@@ -121,7 +137,7 @@ def cross_validate_many(ds: Dataset, fulls: list[FitResult], nfev: int = FOLD_NF
                         workers: Workers | None = None) -> list[CVResult]:
     """:func:`cross_validate` of several fits, all their folds as one batch of tasks."""
     folds = _run(ds, [t for f in fulls for t in fold_tasks(ds, f, nfev)], workers)
-    n = len(ds.groups)
+    n = len(material_folds(ds.groups))
     return [CVResult(form=f.form.name, folds=folds[i * n:(i + 1) * n]) for i, f in enumerate(fulls)]
 
 
@@ -131,11 +147,13 @@ def _run(ds: Dataset, tasks, workers: Workers | None) -> list:
 
 
 def fold_tasks(ds: Dataset, full: FitResult, nfev: int = FOLD_NFEV, tol: float = FOLD_TOL) -> list[tuple]:
-    """The folds of ``full`` as ``(fold_fit, args)`` tasks (``Workers.run``), one per material."""
+    """The folds of ``full`` as ``(fold_fit, args)`` tasks (``Workers.run``, :func:`material_folds`)."""
     groups = ds.groups
     if len(groups) < 2:
         raise ValueError("cross-validation needs at least two materials")
-    return [(fold_fit, (full.form, full.params, full.coeff_dict, g, nfev, tol)) for g in groups]
+    sets = material_folds(groups)
+    return [(fold_fit, (full.form, full.params, full.coeff_dict, m, nfev, tol, f"fold {i + 1}/{len(sets)}"))
+            for i, m in enumerate(sets)]
 
 
 # ------------------------------------------------------------------ held-out regimes

@@ -129,7 +129,7 @@ class RunCurve:
 
     key: str
     material: Material
-    group: str            # material label; leave-one-material-out folds group by it
+    group: str            # material label; the cross-validation folds group by it
     radius: float         # R of the deformable body
     indenter_radius: float  # R_i of the rigid surface (inf: flat)
     rho: float            # relative radius ρ

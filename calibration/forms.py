@@ -38,9 +38,10 @@ from ..model.single import (
     effective_exponent,
     ludwik_representative_stress,
     representative_strain,
-    representative_stress,
+    spread_average,
 )
 from .dataset import Dataset
+from .flowtables import FlowTables
 
 #: collapse c²_c is parametrised by its value and slopes at this a/R
 X_C2 = 0.5
@@ -461,11 +462,27 @@ def _stress_at(ds: Dataset, eps, spread: float, copies: int = 1):
     with np.errstate(invalid="ignore"):
         sig, m = ludwik_representative_stress(sy, K, n, eps, spread)
     m = np.where(np.isfinite(sig), m, 0.0)  # 0 for elastic bodies (σ_Y = inf)
-    for i, mat in enumerate(mats):
-        if not ludwik[i]:
-            sel = run == i
-            sig[sel], m[sel] = representative_stress(mat, eps[sel], spread)
+    if not all(ludwik):
+        table_of_run, tables = _flow_tables(ds)
+        sel = table_of_run[run] >= 0
+        rows, e = table_of_run[run[sel]], eps[sel]
+        if spread == 0.0:  # representative_stress: σ_f and flow_log_slope
+            s, slope = tables.flow(rows, e)
+            sig[sel], m[sel] = s, np.maximum(e, 0.0) * slope / s
+        else:
+            sig[sel], m[sel] = spread_average(lambda x: tables.flow(rows, x), np.maximum(e, 0.0), spread)
     return sig, m
+
+
+def _flow_tables(ds: Dataset) -> tuple[np.ndarray, FlowTables]:
+    """Each run's row in the stacked tables of the tabulated runs (−1: a Ludwik run) and the
+    tables (``flowtables.FlowTables``), memoised."""
+    def make():
+        tab = [i for i, c in enumerate(ds.curves) if c.material.is_tabulated]
+        row = np.full(len(ds.curves), -1)
+        row[tab] = np.arange(len(tab))
+        return row, FlowTables([ds.curves[i].material for i in tab])
+    return _memo(ds, "flow_tables", (), make)
 
 
 def _local_exponent(ds: Dataset, co: Coefficients) -> tuple[np.ndarray, np.ndarray]:

@@ -5,13 +5,14 @@
 (``spherecontact.data.Database``) and writes ``data/coefficients.json``.
 
 Choice of the form, by the numbers: every candidate of ``forms.CANDIDATES`` is fitted
-and cross-validated (leave one material out); the chosen form has the smallest
+and cross-validated (``crossval``: five folds of held-out materials); the chosen form has the smallest
 pooled CV error E_cv = sqrt((RMS_F² + RMS_a²)/2) (F and a at the FE's approaches, ``fit``)
 among the forms whose coefficient
 set passes the monotonicity/continuity check (``check``); a form with fewer parameters
 is preferred when its E_cv is within ``PARSIMONY`` (relative) of the smallest. The large-deformation
 options (ratio a/R or a/ρ, collapse blend or not) are compared on the full set with
-the chosen Level II form.
+the chosen Level II form. They, the chosen form's regime folds and its diagnostics are queued
+as soon as the parsimony rule has picked a form and run while its check decides (``Workers.submit``).
 """
 
 from __future__ import annotations
@@ -58,8 +59,8 @@ PARSIMONY = 0.02
 STAT_SIGNIFICANT = 3
 
 METHOD = ("scipy.optimize.least_squares (trf, bounds) of ln(p_m) and ln(c2), model/FE, on FE "
-          "curves resampled uniformly in ln h; form chosen by leave-one-material-out "
-          "cross-validation")
+          "curves resampled uniformly in ln h; form chosen by cross-validation "
+          "over five folds of held-out materials")
 
 REFERENCES = {
     "beta": "Fitted to the FE calibration set (Ludwik hardening runs); Tabor (1951) 0.2, "
@@ -123,6 +124,18 @@ def _variant(form: Form, **changes) -> Form:
 def _fit_and_check(ds: Dataset, form: Form, materials, start=None) -> tuple[FitResult, bool]:
     r = fit(ds, form, start=start)
     return r, all(c.ok for c in check_all(r.coeffs, materials))
+
+
+#: the model's error per calibration run (``check.run_errors``) in this many worker tasks
+RUN_ERROR_TASKS = 2
+
+
+def _run_errors(ds: Dataset, coeffs, part: int) -> list[RunError]:
+    """``check.run_errors`` of the runs of ``ds`` in part ``part`` of ``RUN_ERROR_TASKS`` consecutive
+    parts (a task of ``workers``)."""
+    n = len(ds.curves)
+    lo, hi = part * n // RUN_ERROR_TASKS, (part + 1) * n // RUN_ERROR_TASKS
+    return [run_errors(c, coeffs) for c in ds.curves[lo:hi]]
 
 
 def _warm_start(form: Form, base: FitResult) -> np.ndarray:
@@ -212,12 +225,28 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
         e = fits[name].errors
         return math.sqrt(0.5 * (rms(e["F"]) ** 2 + rms(e["a"]) ** 2))
 
+    def follow_up(name: str):
+        """Queue the large-deformation alternatives (the slowest task first), the regime folds and
+        the diagnostics of ``name``: they run while its check decides whether it is chosen."""
+        base = fits[name]
+        variants = ({"ratio a/rho": _variant(base.form, name=base.form.name + "_a_over_rho",
+                                             ratio="a_over_rho"),
+                     "no collapse": _variant(base.form, name=base.form.name + "_no_collapse",
+                                             collapse=False)} if large_deformation_options else {})
+        regimes = (regime_tasks(ds, base, folds.nfev, folds.tol)
+                   if cross_validation and len(ds.curves) >= 2 else [])
+        tasks = ([(_fit_and_check, (form, mats, _warm_start(form, base))) for form in variants.values()]
+                 + regimes + [(noise_floor, ()), (breakdown, (base.coeffs, base.errors))]
+                 + [(_run_errors, (base.coeffs, i)) for i in range(RUN_ERROR_TASKS)])
+        return variants, len(regimes), pool.submit(tasks)
+
     remaining = sorted(candidates, key=lambda n: (score(n), FORMS[n].n_params, n))
     chosen = None
     while remaining and chosen is None:
         limit = score(remaining[0]) * (1.0 + PARSIMONY)
         pick = min((n for n in remaining if score(n) <= limit),
                    key=lambda n: (FORMS[n].n_params, score(n), n))
+        queued = follow_up(pick)  # dropped if the check refuses the pick
         if passes(pick):
             chosen = pick
         else:
@@ -226,33 +255,18 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
         raise ValueError("no candidate form gives a monotone and continuous F(h): "
                          + "; ".join(f"{n}: {[c.label for c in checks[n] if not c.ok][:3]}"
                                      for n in checks))
-    for name in candidates:  # the forms that scored better but were not chosen: checked too
-        if score(name) < score(chosen):
-            passes(name)
-    timings["checks_s"] = time.perf_counter() - t - interface_s
+    timings["choice_s"] = time.perf_counter() - t
     if pairs:
         timings["interface_s"] = interface_s
-    alternatives, alt_ok = {}, {}
-    if large_deformation_options:
-        t = time.perf_counter()
-        base = fits[chosen]
-        variants = {"ratio a/rho": _variant(base.form, name=base.form.name + "_a_over_rho",
-                                            ratio="a_over_rho"),
-                    "no collapse": _variant(base.form, name=base.form.name + "_no_collapse",
-                                            collapse=False)}
-        done = pool.map(_fit_and_check, [(form, mats, _warm_start(form, base))
-                                         for form in variants.values()])
-        for label, (r, ok) in zip(variants, done, strict=True):
-            alternatives[label], alt_ok[label] = r, ok
-        timings["alternatives_s"] = time.perf_counter() - t
-    # the regime folds and the diagnostics (noise floor, error bands) in one batch
     t = time.perf_counter()
-    tasks = (regime_tasks(ds, fits[chosen], folds.nfev, folds.tol)
-             if cross_validation and len(ds.curves) >= 2 else [])
-    *regimes, noise, bands = pool.run(tasks + [(noise_floor, ()),
-                                               (breakdown, (fits[chosen].coeffs, fits[chosen].errors))])
-    timings["regimes_and_diagnostics_s"] = time.perf_counter() - t
-    errs = [run_errors(c, fits[chosen].coeffs) for c in ds.curves]
+    variants, n_regimes, results = queued
+    done = results()
+    alternatives = {label: r for label, (r, _) in zip(variants, done, strict=False)}
+    alt_ok = {label: ok for label, (_, ok) in zip(variants, done, strict=False)}
+    regimes = done[len(variants):len(variants) + n_regimes]
+    noise, bands, *per_task = done[len(variants) + n_regimes:]
+    errs = [e for part in per_task for e in part]
+    timings["follow_up_wait_s"] = time.perf_counter() - t
     return Calibration(dataset=ds, fits=fits, cv=cv, chosen=chosen, checks=checks[chosen],
                        run_errors=errs, alternatives=alternatives, alternative_checks=alt_ok,
                        form_checks=dict(checks_ok), timings=timings, noise=noise, breakdown=bands,

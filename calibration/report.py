@@ -224,7 +224,7 @@ def _parameters_chart(ctx: _Context, plt) -> str:
     axes[0].plot([], [], "o", color="tab:blue", label="F(h)")
     axes[0].plot([], [], "s", color="tab:orange", label="a(h)")
     axes[0].legend()
-    fig.suptitle("leave-one-material-out cross-validation: error against parameters (chosen form: large)")
+    fig.suptitle("cross-validation by held-out materials: error against parameters (chosen form: large)")
     fig.tight_layout()
     fig.savefig(out / "cv_parameters.png", dpi=110)
     plt.close(fig)
@@ -280,20 +280,21 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
                  f"| {q['Lambda'][m].min():.3g}–{q['Lambda'][m].max():.3g} |")
     L.append("")
 
-    L.append("## Choice of the Level II form: leave-one-material-out cross-validation\n")
-    L.append("Each fold holds out every run of one material (both scenes), refits on the rest "
-             f"(warm start from the full fit, solved to a relative tolerance of {cal.folds.tol:g} with at "
-             f"most {cal.folds.nfev} evaluations: a fold stopped early stays near the full fit, which has "
-             "seen the held-out material; with the default 1e-5 and 30 some folds stop before their "
-             "minimum, and the held-out errors here are lower than those of solved folds: "
-             "`--fold-nfev 100 --fold-tol 1e-8`, figures in `calibration/README.md`) and predicts "
-             "the held-out points. Score "
+    n_folds = len(next(iter(cal.cv.values())).folds) if cal.cv else 0
+    L.append("## Choice of the Level II form: cross-validation by held-out materials\n")
+    L.append(f"The materials (both scenes of each) are dealt in turn into {n_folds} folds; each fold holds "
+             "out every run of its materials, refits on the rest (warm start from the full fit, "
+             f"solved to a relative tolerance of {cal.folds.tol:g} with at most {cal.folds.nfev} "
+             "evaluations; 'shift' below: how far that moved the predictions) and predicts the held-out "
+             "points. Leaving one material out instead left the folds at the full fit, whose errors they "
+             "then repeated (`calibration/crossval.py`). Score "
              "E_cv = √((RMS_F² + RMS_a²)/2), the errors of F and a at the FE's approaches (what "
              "validation measures; `calibration/fit.py`), over all held-out points; among the forms "
              "whose F(h) "
              "passes the monotonicity check, the one with fewest parameters within 2 % (relative) "
-             "of the smallest E_cv is chosen. 'monotone': checked for the chosen form, any form "
-             "tried before it and any form with a smaller E_cv.\n")
+             "of the smallest E_cv is chosen. 'monotone': checked for the chosen form and any form "
+             "tried before it (the check of a form is the interface fit and the monotonicity grid: a "
+             "form left out by the parsimony rule is not checked).\n")
     L.append("| form | parameters | fit RMS H̄ | fit RMS c² | fit RMS F / a | CV RMS H̄ | CV RMS c² "
              "| CV RMS F | CV max F | CV RMS a | CV max a | E_cv | worst fold (F) | monotone |")
     L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -333,17 +334,17 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
     L.append(f"\nChosen: **{cal.chosen}**.\n")
     if cal.chosen in cal.cv:
         L.append(f"Folds of the chosen form `{cal.chosen}` and of `seed` (held-out RMS; 'shift': change "
-                 "of the predicted H̄, c² over all points when the material is dropped, RMS/max):\n")
-        L.append("| held-out material | points | RMS H̄ | RMS c² | shift RMS | shift max | seed RMS H̄ "
-                 "| seed RMS c² |")
-        L.append("|---|---|---|---|---|---|---|---|")
+                 "of the predicted H̄, c² over all points when the fold's materials are dropped, RMS/max):\n")
+        L.append("| fold | materials held out | points | RMS H̄ | RMS c² | shift RMS | shift max "
+                 "| seed RMS H̄ | seed RMS c² |")
+        L.append("|---|---|---|---|---|---|---|---|---|")
         seed = {f.group: f for f in cal.cv["seed"].folds} if "seed" in cal.cv else {}
         for f in cal.cv[cal.chosen].folds:
             sf = seed.get(f.group)
             sc = [_pct(rms(sf.errors["H_bar"])), _pct(rms(sf.errors["c2"]))] if sf else ["—", "—"]
             eH, ec = _pct(rms(f.errors["H_bar"])), _pct(rms(f.errors["c2"]))
-            L.append(f"| {f.group} | {f.n_points} | {eH} | {ec} | {_pct(f.shift_rms)} | {_pct(f.shift_max)} "
-                     f"| {sc[0]} | {sc[1]} |")
+            L.append(f"| {f.group} | {'; '.join(f.materials)} | {f.n_points} | {eH} | {ec} "
+                     f"| {_pct(f.shift_rms)} | {_pct(f.shift_max)} | {sc[0]} | {sc[1]} |")
         L.append("")
 
     if cal.alternatives:

@@ -67,6 +67,16 @@ class Workers:
             return [fn(self.ds, *args) for fn, args in tasks]
         return list(self._pool.map(_run, tasks))
 
+    def submit(self, tasks):
+        """Queue ``tasks`` (as :meth:`run`) and return a function that waits for their results:
+        they run while this process goes on and queues more (without a pool they run when the
+        results are asked for)."""
+        tasks = list(tasks)
+        if self._pool is None:
+            return lambda: [fn(self.ds, *args) for fn, args in tasks]
+        futures = [self._pool.submit(_run, t) for t in tasks]
+        return lambda: [f.result() for f in futures]
+
     def run_then(self, tasks, then) -> tuple[list, list[list]]:
         """The results of ``tasks`` (as :meth:`run`) and, for each, the results of the tasks
         ``then(i, result)`` (a list of ``(fn, args)``), which start as soon as that result is

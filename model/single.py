@@ -74,6 +74,7 @@ __all__ = [
     "spread_factors",
     "curvature_ratio",
     "flow_log_slope",
+    "spread_average",
     "effective_exponent",
     "local_exponent",
     "capped_exponent",
@@ -149,21 +150,29 @@ def representative_stress(material: Material, eps, spread: float = 0.0):
         return material.flow_stress(eps), flow_log_slope(material, eps)
     e = np.maximum(np.asarray(eps, dtype=float), 0.0)
     elastic = material.is_rigid or math.isinf(material.sigma_y)
-    if not (elastic or material.is_tabulated):
+    if elastic:
+        return sum(w * material.flow_stress(f * e) for f, w in spread_factors(spread)), np.zeros_like(e)
+    if not material.is_tabulated:
         return ludwik_representative_stress(material.sigma_y, material.K, material.n, e, spread)
+    return spread_average(lambda x: (material.flow_stress(x), material.flow_slope(x)), e, spread)
+
+
+def spread_average(flow, e, spread: float):
+    """σ_rep and m of :func:`representative_stress` (W = ``spread`` > 0) for a flow curve given
+    by ``flow(ε)`` → (σ_f, σ_f') at the strains ``e`` ≥ 0 (a table's interpolant; one curve, or
+    one per point as ``calibration.flowtables`` evaluates them)."""
     sig = np.zeros_like(e)
     dsig = np.zeros_like(e)  # Σ w_j ε_j σ_f'(ε_j) = ε dσ_rep/dε
     for f, w in spread_factors(spread):
         ef = f * e
-        s = material.flow_stress(ef)
+        s, slope = flow(ef)
         sig = sig + w * s
-        if not elastic:  # flow_log_slope(material, ef) · σ_f, σ_f(ε_f) not evaluated twice (the
-            # product kept as it was written: ε σ_f' alone differs in the last bit, which moves the
-            # fitted coefficients in their 4th digit, calibration/README.md)
-            dsig = dsig + w * (ef * material.flow_slope(ef) / s) * s
+        # flow_log_slope(material, ef) · σ_f, σ_f(ε_f) not evaluated twice (the product kept as
+        # it was written: ε σ_f' alone differs in the last bit, which moves the fitted
+        # coefficients in their 4th digit, calibration/README.md)
+        dsig = dsig + w * (ef * slope / s) * s
     with np.errstate(invalid="ignore", divide="ignore"):
-        m = np.zeros_like(e) if elastic else np.where(sig > 0.0, dsig / sig, 0.0)
-    return sig, m
+        return sig, np.where(sig > 0.0, dsig / sig, 0.0)
 
 
 def curvature_ratio(radius, rho_hertz):

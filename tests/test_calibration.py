@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from spherecontact.calibration import cli
-from spherecontact.calibration.crossval import cross_validate
+from spherecontact.calibration.crossval import FOLDS, cross_validate, material_folds
 from spherecontact.calibration.dataset import build_dataset, quantities, resample
 from spherecontact.calibration.fit import Residuals, fit, rms
 from spherecontact.calibration.forms import FORMS, predict, predict_exact
@@ -210,9 +210,21 @@ def test_cross_validation_on_synthetic_data_is_small():
     ds = build_dataset(synthetic_runs(SMALL, noise=0.002))
     full = fit(ds, FORMS["smooth"])
     cv = cross_validate(ds, full)
-    assert len(cv.folds) == len(ds.groups) == 7
+    # seven materials dealt into FOLDS = 5 folds: each material held out once, every point once
+    assert len(ds.groups) == 7 and len(cv.folds) == FOLDS
+    held = [m for f in cv.folds for m in f.materials]
+    assert sorted(held) == ds.groups
+    assert sum(f.n_points for f in cv.folds) == ds.size
+    # every fold is refitted: its parameters and predictions move away from the full fit's
+    for f in cv.folds:
+        assert np.max(np.abs(f.params - full.params)) > 1e-6 and f.shift_max > 1e-6, f.group
     p = cv.pooled()
     assert p["H_bar"]["rms"] < 0.01 and p["c2"]["rms"] < 0.01
+
+
+def test_materials_are_dealt_into_folds_in_turn():
+    assert material_folds(list("abcdefg"), 5) == [("a", "f"), ("b", "g"), ("c",), ("d",), ("e",)]
+    assert material_folds(["a", "b"], 5) == [("a",), ("b",)]
 
 
 # ------------------------------------------------------------------------------ database errors
@@ -323,11 +335,14 @@ def test_regime_folds_hold_out_whole_regimes_and_predict_them():
         held = [c for c in ds.curves if regime_of(c, f.family) == f.label]
         assert f.runs == len(held) and f.errors["F"].size == sum(c.h.size for c in held)
         assert np.all(np.isfinite(f.errors["F"])), (f.family, f.label)
-    # holding out a regime is harder than holding out one material: with 8 model-made runs the
-    # E/σY decade 1e2–1e3 (4 of them) is extrapolated by the rest to 5.5 % RMS in F
+    # the runs are made by the form itself, so a fold that keeps both scenes and both hardening
+    # bands finds it again from the rest and predicts the held-out E/σY decade to the noise (the
+    # fold starts from the full fit in the shift from it, fit._solve: started at the full fit in
+    # the parameters themselves, trf's first trust radius was ‖x‖ and the fold wandered off, to
+    # 5.5 % RMS in F for the decade 1e2–1e3, 4 of the 8 runs, and 38 % for the rigid spheres)
     by = {(f.family, f.label): rms(f.errors["F"]) for f in folds}
-    worst_material = max(rms(f.errors["F"]) for f in cross_validate(ds, full).folds)
-    assert by[("E/σY decade", "1e2–1e3")] > worst_material
+    for decade in labels["E/σY decade"]:
+        assert by[("E/σY decade", decade)] < 0.005, decade
     # without the hardening runs the data do not determine the hardening terms or β (n = 0 and
     # σ_rep = σ_Y at every training point): their Jacobian columns are exactly zero, so what the
     # fold reports for that regime is the start's hardening terms, not an extrapolation

@@ -6,7 +6,7 @@ import pytest
 from test_calibration import KNOWN_CO, SMALL, synthetic_runs
 
 from spherecontact.calibration import fit as fitmod
-from spherecontact.calibration.crossval import cross_validate, cross_validate_many, fold_tasks
+from spherecontact.calibration.crossval import cross_validate, cross_validate_many, fold_tasks, material_folds
 from spherecontact.calibration.dataset import build_dataset
 from spherecontact.calibration.diagnostics import breakdown, noise_floor
 from spherecontact.calibration.fit import errors, fit
@@ -79,7 +79,7 @@ def test_folds_queued_behind_their_fit_are_the_serial_ones(small_ds):
         full = fit(small_ds, form)
         np.testing.assert_array_equal(got.params, full.params)
         serial = cross_validate(small_ds, full)
-        assert [f.group for f in got_folds] == small_ds.groups
+        assert [f.materials for f in got_folds] == material_folds(small_ds.groups)
         for a, b in zip(serial.folds, got_folds, strict=True):
             np.testing.assert_array_equal(a.params, b.params)
             np.testing.assert_array_equal(a.errors["F"], b.errors["F"])
@@ -181,7 +181,7 @@ def test_fold_solve_is_checked_and_reaches_the_folds(small_ds):
     assert cli.main(["--fold-nfev", "0", "--db", "nowhere.h5"]) == 2
     assert cli.main(["--fold-tol", "1", "--db", "nowhere.h5"]) == 2
     full = fit(small_ds, FORMS["smooth"])
-    group = small_ds.groups[0]
+    group = (small_ds.groups[0],)
     capped = fold_fit(small_ds, full.form, full.params, full.coeff_dict, group, 1)
     solved = fold_fit(small_ds, full.form, full.params, full.coeff_dict, group, 200, 1e-10)
     assert np.max(np.abs(capped.params - full.params)) < np.max(np.abs(solved.params - full.params))
