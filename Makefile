@@ -7,7 +7,7 @@ export OMP_NUM_THREADS ?= 1
 export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
-.PHONY: test bench lint verify-fem verify-pair verify-cycles verify-smoothness verify-band demo clean
+.PHONY: test bench lint verify-fem verify-pair verify-cycles verify-smoothness verify-band verify-increments demo clean
 .PHONY: fem fem-v1 campaign-design
 .PHONY: validate
 .PHONY: calibrate
@@ -49,6 +49,9 @@ verify-cycles: $(STAMP)
 
 verify-smoothness: $(STAMP)
 	$(PY) -m spherecontact.fem.smoothness --out reports/fem
+
+verify-increments: $(STAMP)
+	$(PY) -m spherecontact.fem.increments --db data/reference_v2.h5 --out reports/fem
 
 verify-band: $(STAMP)
 	$(PY) -m spherecontact.fem.band_convergence --out reports/fem

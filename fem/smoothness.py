@@ -68,14 +68,27 @@ CASES = [
      {**APPROACH, "tol": 1e-8}),
     ("flat E10000, band 0.02, approach penalty 300, Newton 1e-8, secant predictor", 10000.0,
      math.inf, 0.02, {**APPROACH, "tol": 1e-8, "predictor": "secant"}),
+    # loading increments dh ≤ 0.1 h / 0.05 h (SolverOptions.relative_step), and the band's floor
+    # 0.0002 of R instead of 0.0005 (the band is at its floor for a/R < 0.025 at 0.02)
+    ("flat E10000, band 0.02, approach penalty 300, steps ≤ 0.1 h", 10000.0, math.inf, 0.02,
+     {**APPROACH, "relative_step": 0.1}),
+    ("flat E10000, band 0.02, approach penalty 300, steps ≤ 0.05 h", 10000.0, math.inf, 0.02,
+     {**APPROACH, "relative_step": 0.05}),
+    ("flat E10000, band 0.02 floor 0.0002, approach penalty 300, steps ≤ 0.1 h", 10000.0, math.inf,
+     0.02, {**APPROACH, "relative_step": 0.1, "band_floor": 0.0002}),
+    ("flat E1000, band 0.02, approach penalty 300, steps ≤ 0.1 h", 1000.0, math.inf, 0.02,
+     {**APPROACH, "relative_step": 0.1}),
 ]
 BANDS = ((0.01, 0.03), (0.03, 0.1), (0.1, 0.3), (0.3, 1.2))
 
 
 def measure(E: float, indenter: float, band: float, options: dict, h_max: float = 0.3) -> dict:
-    """One run and its scatter figures (h_max in units of the smaller radius)."""
+    """One run and its scatter figures (h_max in units of the smaller radius); ``options``: the
+    solver's, and the band's smallest size ``band_floor`` (``mesh.build_mesh``) if given."""
+    options = dict(options)
+    floor = options.pop("band_floor", None)
     solver = IndentationSolver(Material(E=E, nu=0.3, sigma_y=1.0), 1.0, RigidObstacle(indenter),
-                               edge_band=band, options=SolverOptions(**options))
+                               edge_band=band, band_floor=floor, options=SolverOptions(**options))
     res = solver.run(h_max * min(1.0, indenter))
     h, F, a = res.h, res.F, res.a
     m = a >= 0.01
@@ -153,7 +166,9 @@ def main(argv: list[str] | None = None) -> int:
         r = {"label": label, "E_over_sigma_y": E, "indenter_radius": ind if np.isfinite(ind) else "inf",
              "edge_band": band, "penalty": options.get("penalty"),
              "segment_points": options.get("segment_points", 0),
-             "penalty_scale": options.get("penalty_scale", "modulus"), **measure(E, ind, band, options)}
+             "penalty_scale": options.get("penalty_scale", "modulus"),
+             "band_floor": options.get("band_floor"), "relative_step": options.get("relative_step"),
+             **measure(E, ind, band, options)}
         results.append(r)
         print(f"{label}: scatter F {100 * r['scatter_F']:.2f} %, a {100 * r['scatter_a']:.2f} %, "
               f"{r['wall_s']:.0f} s, {r['n_dofs']} dofs", flush=True)

@@ -1,5 +1,7 @@
 """Segment-integrated penalty contact (fem/segment_penalty.py) and the surface band of the mesh."""
 
+import math
+
 import numpy as np
 import pytest
 from _meshes import smallest_surface_element
@@ -163,3 +165,36 @@ def test_loading_steps_keep_the_strain_increment_from_the_first_one_on():
     assert c["h"][0] <= eps**2 * (1 + 1e-9)
     dh = np.diff(c["h"])
     assert np.all(dh <= eps * c["a_nodes"][:-1] * (1 + 1e-9))
+
+
+def test_relative_step_bounds_the_loading_increments_by_the_approach():
+    """``relative_step`` r: dh ≤ r · h once in contact, on top of the strain bound (which lets a
+    stiff sphere's increments reach dh ≈ 0.6 h where its contact is small); bad values are named.
+    The force converges as r falls: the strain bound alone leaves F at h/R = 1e-3 (E/σY 1000)
+    2.3 % below the run with r = 0.01, r = 0.1 0.5 % and r = 0.03 0.05 % (the path of the plastic
+    increments across the elastic–plastic transition)."""
+    for bad in (0.0, -0.1, math.inf, 11.0):
+        with pytest.raises(ValueError, match="relative_step"):
+            SolverOptions(relative_step=bad).validate()
+    runs = {r: _flat_run(1000.0, 1e-3, **({} if r is None else {"relative_step": r})).curves
+            for r in (None, 0.1, 0.03)}
+    h = runs[0.1]["h"]
+    assert np.all(np.diff(h)[1:] <= 0.1 * h[1:-1] * (1 + 1e-9))
+    free = runs[None]["h"]
+    assert np.max(np.diff(free)[1:] / free[1:-1]) > 0.3  # the bound acts
+    F_end = {r: c["F"][-1] for r, c in runs.items()}
+    assert abs(F_end[0.03] / F_end[0.1] - 1) < 0.3 * abs(F_end[0.1] / F_end[None] - 1)
+    assert F_end[None] < F_end[0.1] < F_end[0.03]  # the coarse path is low
+
+
+def test_increment_check_reports_the_largest_deviation_per_decade():
+    from spherecontact.fem.increments import by_decade
+
+    h_new = np.geomspace(1e-6, 1e-2, 200)
+    F_new = h_new**1.3
+    h_old = np.array([2e-6, 5e-6, 2e-5, 5e-5, 3e-4, 2e-3])
+    off = np.array([-0.01, -0.03, -0.02, 0.01, 0.004, -0.001])
+    d = by_decade(h_old, h_old**1.3 * np.exp(off), h_new, F_new, 1.0)
+    assert set(d) == {"1e-6", "1e-5", "1e-4", "1e-3", "largest"}
+    assert d["1e-6"] == pytest.approx(-0.03, abs=1e-9) and d["1e-5"] == pytest.approx(-0.02, abs=1e-9)
+    assert d["1e-4"] == pytest.approx(0.004, abs=1e-9) and d["largest"] == pytest.approx(-0.03, abs=1e-9)
