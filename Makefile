@@ -51,7 +51,7 @@ verify-smoothness: $(STAMP)
 	$(PY) -m spherecontact.fem.smoothness --out reports/fem
 
 verify-increments: $(STAMP)
-	$(PY) -m spherecontact.fem.increments --db data/reference_v2.h5 --out reports/fem
+	$(PY) -m spherecontact.fem.increments --db data/reference_v2.h5 --set validation --workers 2 --out reports/fem
 
 verify-band: $(STAMP)
 	$(PY) -m spherecontact.fem.band_convergence --out reports/fem

@@ -10,7 +10,9 @@ compares F and a with the stored curve at its own approaches (loading increments
 first ones, ``io.reference_mask``; log–log interpolation of the new curve), per decade of h.
 
 ``python -m spherecontact.fem.increments --db data/reference_v2.h5 --out reports/fem`` →
-``increments.json`` (``--cases`` picks the cases; ~1 min each on one core).
+``increments_validation.json``: every converged one-body run of the set (``--set``, default
+validation; ``--cases`` picks some), with the re-run curves, which the validation report reads
+(``validation/increments_report.py``); ~8 min for the 30 validation runs on two workers.
 """
 
 from __future__ import annotations
@@ -18,7 +20,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import multiprocessing
 import time
+from concurrent.futures import ProcessPoolExecutor
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -29,9 +33,6 @@ from ..validation.metrics import interp_loglog
 from .io import loading_mask, material_from_description, run_indentation
 from .solver import SolverOptions
 
-#: stiff validation runs of campaign v2, flats and a small rigid sphere (E/σY 2470–11800)
-CASES = ("flat-pp-E2500-nu0.3", "flat-voceQ2.19-b4.81-E2470-nu0.3", "flat-K11-n0.192-E5800-nu0.23",
-         "flat-K4.42-n0.17-E11800-nu0.419", "rsphere0.239-K6.35-n0.266-E2620-nu0.3")
 #: the re-run ends at the campaign's first unloading approach (units of the smaller radius)
 H_END = 0.01
 RELATIVE_STEP = 0.03
@@ -76,32 +77,51 @@ def measure(db: Database, case: str, relative_step: float) -> dict:
             "new_increments": int(new.h.size),
             "F": by_decade(old["h"][keep], old["F"][keep], new.h, new.F, L),
             "a": by_decade(old["h"][ka], old["a"][ka], new.h, new.a, L) if ka.any() else None,
-            "curve": {"h": new.h.tolist(), "F": new.F.tolist(), "a": new.a.tolist()}}
+            "curve": {q: [float(f"{v:.8g}") for v in getattr(new, q)] for q in ("h", "F", "a")}}
+
+
+def _measure_in_worker(args: tuple) -> dict:
+    db_path, case, relative_step = args
+    return measure(Database(db_path), case, relative_step)
+
+
+def one_body_cases(db: Database, set_name: str) -> list[str]:
+    """The cases of ``set_name`` with one deformable body (rigid flat or sphere), sorted."""
+    return sorted(r.case for r in db.records(set=set_name)
+                  if r.inputs.get("scene") in ("rigid_flat", "rigid_sphere") and r.status == "converged")
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--db", default="data/reference_v2.h5")
     ap.add_argument("--out", default="reports/fem")
-    ap.add_argument("--cases", nargs="*", default=list(CASES))
+    ap.add_argument("--set", default="validation", help="every converged one-body case of this set")
+    ap.add_argument("--cases", nargs="*", default=None, help="these cases instead of --set")
     ap.add_argument("--relative-step", type=float, default=RELATIVE_STEP)
+    ap.add_argument("--workers", type=int, default=2, help="processes (one case each at a time)")
+    ap.add_argument("--name", default="increments_validation.json", help="file written in --out")
     args = ap.parse_args(argv)
     db = Database(args.db)
+    cases = args.cases if args.cases else one_body_cases(db, args.set)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     results = {"date_utc": datetime.now(UTC).strftime("%Y-%m-%d"), "db": args.db, "h_end": H_END,
                "note": "ln(stored/new) per decade of h over the smaller radius, largest |.|, at the "
                        "stored loading increments after the first ones (a: where a >= 0.01 of the "
                        "smaller radius); new: increments dh <= relative_step h", "cases": []}
-    for case in args.cases:
-        r = measure(db, case, args.relative_step)
-        results["cases"].append(r)
-        a = f"{100 * r['a']['largest']:+.2f} %" if r["a"] else "—"
-        print(f"{case}: F {100 * r['F']['largest']:+.2f} %, a {a} "
-              f"({r['stored_increments']} → {r['new_increments']} increments, {r['wall_s']:.0f} s)",
-              flush=True)
-        (out / "increments.json").write_text(json.dumps(results, indent=1) + "\n")
+    with ProcessPoolExecutor(max(1, args.workers), mp_context=multiprocessing.get_context("fork")) as pool:
+        done = pool.map(_measure_in_worker, [(args.db, c, args.relative_step) for c in cases])
+        for case, r in zip(cases, done, strict=True):
+            results["cases"].append(r)
+            _print(case, r)
+            (out / args.name).write_text(json.dumps(results, indent=1) + "\n")
     return 0
+
+
+def _print(case: str, r: dict) -> None:
+    a = f"{100 * r['a']['largest']:+.2f} %" if r["a"] else "—"
+    print(f"{case}: F {100 * r['F']['largest']:+.2f} %, a {a} "
+          f"({r['stored_increments']} → {r['new_increments']} increments, {r['wall_s']:.0f} s)", flush=True)
 
 
 if __name__ == "__main__":

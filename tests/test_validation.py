@@ -354,3 +354,34 @@ def test_report_reads_no_uncommitted_verification_runs_by_default():
     args = _parser().parse_args([])
     assert args.studies_fallback == ""
     assert _parser().parse_args(["--studies-fallback", "reports/fem"]).studies_fallback == "reports/fem"
+
+
+def test_small_contact_section_reads_the_model_against_converged_fe(tmp_path):
+    """A stored 'FE' 3 % below the model whose converged re-run is the model's own curve: the
+    model's 3 % error there is the FE's (``increments_report``)."""
+    import json
+
+    from spherecontact.validation.increments_report import (
+        load_converged,
+        small_contact_rows,
+        small_contact_section,
+    )
+
+    low = make_case("low", scale_F=1 / 1.03)
+    s1, s2 = spheres(low)
+    hc = np.geomspace(1e-4, 0.01, 80)
+    Fc = contact(s1, s2, hc).F
+    path = tmp_path / "increments_validation.json"
+    path.write_text(json.dumps({"date_utc": "2026-11-27", "h_end": 0.01, "cases": [
+        {"key": low.key, "relative_step": 0.03, "curve": {"h": hc.tolist(), "F": Fc.tolist()}}]}))
+    store = load_converged(path)
+    assert load_converged(tmp_path / "absent.json") is None
+    comp = compare_case(low, None, TH)
+    (row,) = small_contact_rows([comp, compare_case(make_case("other"), None, TH)], store)
+    assert row["run"] == "low" and row["points"] > 5
+    assert row["fe"][0] == pytest.approx(1 / 1.03 - 1, abs=2e-3)
+    assert row["model_stored"][0] == pytest.approx(0.03, abs=1e-9)
+    assert abs(row["model_converged"][0]) < 2e-3 and row["model_converged"][1] <= 0.01
+    text = "\n".join(small_contact_section([comp], store))
+    assert "closer to the converged curve on 1 of 1 runs" in text
+    assert "not compared" in "\n".join(small_contact_section([comp], None))

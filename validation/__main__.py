@@ -35,6 +35,9 @@ def _parser() -> argparse.ArgumentParser:
                         "committed)")
     p.add_argument("--mdr", default="data/peers/mdr.json",
                    help="stored LAMMPS mdr curves (JSON; a missing file leaves mdr out)")
+    p.add_argument("--converged-fe", default="reports/fem/increments_validation.json",
+                   help="first loadings re-run with increments dh <= r h (make verify-increments; a "
+                        "missing file leaves the section out)")
     p.add_argument("--study-runs", default="reports/validation/studies",
                    help="directory of the validation's own study runs (*.json), used with the fallback")
     return p
@@ -79,6 +82,9 @@ def main(argv: list[str] | None = None) -> int:
             from .mdr import load_store
 
             mdr = load_store(args.mdr)
+        from .increments_report import load_converged
+
+        converged = load_converged(args.converged_fe) if args.converged_fe else None
     except (OSError, ValueError) as err:
         print(f"validation: {err}", file=sys.stderr)
         return 2
@@ -87,7 +93,8 @@ def main(argv: list[str] | None = None) -> int:
     res = build_report(validation, studies, coeffs, th, args.out, source=str(db),
                        coeff_path=args.coefficients or "model default", th_path=args.thresholds,
                        skipped=skipped,
-                       studies_source=studies_source, mdr=mdr, mdr_source=args.mdr)
+                       studies_source=studies_source, mdr=mdr, mdr_source=args.mdr,
+                       converged=converged)
     dt = time.perf_counter() - t0
     print(f"validation: {len(res.comparisons)} runs, report {res.path} ({len(res.pngs)} charts), "
           f"{dt:.1f} s")

@@ -13,6 +13,7 @@ from .cases import Case
 from .charts import curves_chart, error_chart, representative
 from .compare import W_ACCEPT, Comparison, compare_case
 from .config import Thresholds
+from .increments_report import small_contact_section
 from .mdr_report import mdr_section
 from .stability import (
     extreme_section,
@@ -85,11 +86,12 @@ def _header(source: str, coeffs: Coefficients, coeff_path: str, th: Thresholds, 
 def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficients | None,
                  th: Thresholds, out, *, source: str = "", coeff_path: str = "", th_path: str = "",
                  skipped: list[str] | None = None,
-                 studies_source: str = "", mdr=None, mdr_source: str = "") -> ReportResult:
+                 studies_source: str = "", mdr=None, mdr_source: str = "", converged=None) -> ReportResult:
     """Compare every validation run, run the studies, write ``out/index.md`` and the PNGs.
 
     ``mdr``: the stored LAMMPS mdr curves (:func:`.mdr.load_store`; None: mdr is not
-    given), read from ``mdr_source``.
+    given), read from ``mdr_source``. ``converged``: the first loadings re-run with finer
+    increments (:func:`.increments_report.load_converged`; None: the section says so).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -155,7 +157,8 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            run_table(comps, th), "", "## Per level (all runs pooled, every FE point)", "",
            "Level of a point: the model's level of the body furthest into plasticity; "
            f"`large deformation`: h/R > {th.large_deformation_from:g}. Max (RMS) error %.", "",
-           "**F**", "", level_table(comps, "F"), "", "**a**", "", level_table(comps, "a")]
+           "**F**", "", level_table(comps, "F"), "", "**a**", "", level_table(comps, "a"), ""]
+    md += small_contact_section(comps, converged)
 
     # ------------------------------------------------------------------ charts
     if comps:
