@@ -85,6 +85,23 @@ def test_folds_queued_behind_their_fit_are_the_serial_ones(small_ds):
             np.testing.assert_array_equal(a.errors["F"], b.errors["F"])
 
 
+def _size_times(ds, k):
+    return ds.size * k
+
+
+def test_submitted_tasks_run_while_more_are_queued_and_come_back_in_order(small_ds):
+    """``Workers.submit``: the calibration queues the chosen form's follow-up work and goes on
+    queueing its check; the results are those of ``run``, in submission order, with a pool and
+    without one (then they run when asked for)."""
+    tasks = [(_size_times, (k,)) for k in range(6)]
+    with Workers(small_ds, 2) as pool:
+        first = pool.submit(tasks)
+        second = pool.run(tasks[:3])  # queued behind the first batch
+        assert first() == pool.run(tasks) and second == [small_ds.size * k for k in range(3)]
+    lazy = Workers(small_ds, 1).submit(tasks)
+    assert lazy() == [small_ds.size * k for k in range(6)]
+
+
 def test_subset_is_the_dataset_built_from_its_curves(small_ds):
     """A fold's dataset is sliced from the full one (``Dataset.subset``): the same arrays as
     building it from the fold's curves, in the order of the runs asked for."""
