@@ -261,10 +261,10 @@ def _calibrate(ds: Dataset, pool: Workers, candidates, cross_validation: bool,
     t = time.perf_counter()
     variants, n_regimes, results = queued
     done = results()
-    alternatives = {label: r for label, (r, _) in zip(variants, done, strict=False)}
-    alt_ok = {label: ok for label, (_, ok) in zip(variants, done, strict=False)}
-    regimes = done[len(variants):len(variants) + n_regimes]
-    noise, bands, *per_task = done[len(variants) + n_regimes:]
+    fitted, regimes, (noise, bands, *per_task) = (done[:len(variants)], done[len(variants):][:n_regimes],
+                                                   done[len(variants) + n_regimes:])
+    alternatives = {label: r for label, (r, _) in zip(variants, fitted, strict=True)}
+    alt_ok = {label: ok for label, (_, ok) in zip(variants, fitted, strict=True)}
     errs = [e for part in per_task for e in part]
     timings["follow_up_wait_s"] = time.perf_counter() - t
     return Calibration(dataset=ds, fits=fits, cv=cv, chosen=chosen, checks=checks[chosen],
