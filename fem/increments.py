@@ -114,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
         for case, r in zip(cases, done, strict=True):
             results["cases"].append(r)
             _print(case, r)
-            (out / args.name).write_text(json.dumps(results, indent=1) + "\n")
+            (out / args.name).write_text(json.dumps(results, separators=(",", ":")) + "\n")
     return 0
 
 
