@@ -37,6 +37,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "calibration/README.md)")
     p.add_argument("--fold-tol", type=float, default=FOLD_TOL, metavar="TOL",
                    help=f"stopping tolerance of a fold fit, 1e-15-1e-2 (default {FOLD_TOL:g})")
+    p.add_argument("--converged-fe", default=None, metavar="JSON",
+                   help="replace each run's first loading by its re-run with finer increments "
+                        "(make verify-increments --set calibration, reports/fem/"
+                        "increments_calibration.json); default: the runs as stored")
     p.add_argument("--converged-only", action="store_true",
                    help="leave out runs that stopped before h_max (default: fit their converged "
                         "increments)")
@@ -62,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         cal = calibrate(args.db, out=args.out, report_dir=args.report or None,
                         include_stopped=not args.converged_only, candidates=forms,
-                        workers=args.workers, folds=folds)
+                        workers=args.workers, folds=folds, converged_fe=args.converged_fe)
     except FileNotFoundError as err:
         print(f"calibrate: error: reference database not found: {err.filename or args.db}",
               file=sys.stderr)

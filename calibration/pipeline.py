@@ -342,6 +342,46 @@ def load_runs(db_path, include_stopped: bool = True, db=None, content_hash: bool
     return [(f"{r.case} [{r.key}]", run) for r, run in pairs], source
 
 
+class FirstLoadingReplaced:
+    """A run whose loading curve up to ``h_end`` (units of the smaller radius) is its re-run with
+    increments bounded by the approach (``fem/increments.py``: the campaign's increments leave a
+    stiff sphere's curve up to 10 % low there); the rest of the loading curve, the cycles and
+    every other attribute are the run's own."""
+
+    def __init__(self, run, converged: dict, h_end: float):
+        self._run = run
+        L = min(float(run.inputs["radius"]), float(run.inputs.get("indenter_radius", math.inf)))
+        h, F, a = (np.asarray(v, dtype=float) for v in (run.h, run.F, run.a))
+        ref = np.asarray(getattr(run, "reference", np.ones(h.size, bool)), dtype=bool)
+        keep = ref & (h > h_end * L * (1.0 + 1e-9))
+        new = [np.asarray(converged["curve"][q], dtype=float) for q in ("h", "F", "a")]
+        self.h, self.F, self.a = (np.concatenate([n, o[keep]]) for n, o in zip(new, (h, F, a), strict=True))
+        self.reference = np.ones(self.h.size, dtype=bool)
+
+    def __getattr__(self, name):
+        return getattr(self._run, name)
+
+
+def load_converged_first_loading(path) -> tuple[dict, float]:
+    """``(key → re-run case, h_end)`` of a ``fem/increments.py`` file (``--converged-fe``)."""
+    d = json.loads(Path(path).read_text())
+    return {c["key"]: c for c in d["cases"]}, float(d["h_end"])
+
+
+def replace_first_loading(runs, path) -> tuple[list, list[str]]:
+    """``runs`` (``(name, run)``, names ending in ``[key]``) with the first loading of those the
+    file at ``path`` re-ran replaced (:class:`FirstLoadingReplaced`), and the keys replaced."""
+    converged, h_end = load_converged_first_loading(path)
+    out, done = [], []
+    for name, run in runs:
+        key = name.rsplit("[", 1)[-1].rstrip("]")
+        if key in converged:
+            run = FirstLoadingReplaced(run, converged[key], h_end)
+            done.append(key)
+        out.append((name, run))
+    return out, done
+
+
 def source_path(db_path) -> str:
     """The database path as the file records it: relative to the working directory when the
     database lies under it (``data/reference.h5`` whether given as that, ``./data/…`` or
@@ -426,6 +466,8 @@ def coefficient_file(cal: Calibration) -> dict:
                       "calibration_runs_hash: SHA-256 of the keys, statuses and curves h, F, a of "
                       "the runs used (unchanged when other sets are added)",
             "set": "calibration",
+            **({"first_loading_replaced": cal.source["first_loading_replaced"]}
+               if "first_loading_replaced" in cal.source else {}),
             "runs": len(ds.curves),
             "materials": len(ds.groups),
             "points": ds.size,
@@ -496,14 +538,19 @@ def write_json(path, d: dict) -> Path:
 
 def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
               candidates=CANDIDATES, workers: int = DEFAULT_WORKERS,
-              folds: FoldSolve = DEFAULT_FOLDS) -> Calibration:
-    """Calibrate from the database at ``db_path``; write the coefficient file and the report."""
+              folds: FoldSolve = DEFAULT_FOLDS, converged_fe=None) -> Calibration:
+    """Calibrate from the database at ``db_path``; write the coefficient file and the report.
+    ``converged_fe``: a ``fem/increments.py`` file whose re-run first loadings replace the runs'
+    own (:func:`replace_first_loading`; recorded in the file's ``fe_dataset``)."""
     t0 = time.perf_counter()
     from spherecontact.data import Database
 
     with _content_hash_aside(db_path) as content_hash:
         db = Database(db_path)  # opened once: listing its entries reads every run's attributes
         runs, source = load_runs(db_path, include_stopped, db=db, content_hash=False)
+        if converged_fe is not None:
+            runs, replaced = replace_first_loading(runs, converged_fe)
+            source["first_loading_replaced"] = {"path": source_path(converged_fe), "runs": len(replaced)}
         two = two_body_runs(db)
         pairs = load_pairs(db_path, runs=two)
         source["pairs"] = [c.name for c in pairs]

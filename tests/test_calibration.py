@@ -381,3 +381,30 @@ def test_chart_labels_are_the_shortest_distinct_tails_of_the_form_names():
              "smooth2_fs2_xn2n_x2_g_csl_w1_sn_zn_nl_cz"]
     assert list(_short_names(names).values()) == ["seed", "…_zn_nl", "…_nl_czh", "…_nl_cz"]
     assert _short_names(["a_b_c", "x_b_c"]) == {"a_b_c": "a_b_c", "x_b_c": "x_b_c"}  # only whole names differ
+
+
+def test_a_converged_first_loading_replaces_the_run_s_own(small_db, tmp_path):
+    """``--converged-fe``: the first loading of a run (h ≤ h_end of the smaller radius) is taken
+    from a re-run with finer increments; the rest of the curve is the run's, and the coefficient
+    file says how many runs were replaced."""
+    from spherecontact.calibration.pipeline import coefficient_file, replace_first_loading
+
+    runs, _ = load_runs(small_db, content_hash=False)
+    name, run = runs[0]
+    key = name.rsplit("[", 1)[-1].rstrip("]")
+    L = min(float(run.inputs["radius"]), float(run.inputs.get("indenter_radius", math.inf)))
+    hc = np.geomspace(1e-5, 0.01, 40) * L
+    curve = {"h": hc.tolist(), "F": (2.0 * hc).tolist(), "a": np.sqrt(hc).tolist()}
+    path = tmp_path / "increments_calibration.json"
+    path.write_text(json.dumps({"h_end": 0.01, "cases": [{"key": key, "curve": curve}]}))
+    new, replaced = replace_first_loading(runs, path)
+    assert replaced == [key] and [n for n, _ in new] == [n for n, _ in runs]
+    r = new[0][1]
+    head = r.h <= 0.01 * L * (1 + 1e-9)
+    np.testing.assert_array_equal(r.h[head], hc)
+    np.testing.assert_array_equal(r.F[head], 2.0 * hc)
+    tail = np.asarray(run.h) > 0.01 * L * (1 + 1e-9)
+    np.testing.assert_array_equal(r.F[~head], np.asarray(run.F)[tail])
+    assert r.inputs is run.inputs and new[1][1] is runs[1][1]
+    cal = calibrate(small_db, candidates=("smooth",), converged_fe=path, workers=1)
+    assert coefficient_file(cal)["provenance"]["fe_dataset"]["first_loading_replaced"]["runs"] == 1
