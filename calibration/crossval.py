@@ -114,9 +114,7 @@ def fold_fit(ds: Dataset, form: Form, params: np.ndarray, coeff_dict: dict, mate
     if isinstance(materials, str):
         raise TypeError(f"materials must be a tuple of material labels, got the string {materials!r}")
     full = Coefficients.from_dict(coeff_dict)
-    held = set(materials)
-    train = ds.subset([i for i, c in enumerate(ds.curves) if c.group not in held])
-    test = ds.subset([i for i, c in enumerate(ds.curves) if c.group in held])
+    train, test = ds.without_groups(*materials), ds.only_groups(*materials)
     r = fit(train, form, start=params, max_nfev=nfev, tol=tol)
     p0, c0 = predict(ds, full)
     p1, c1 = predict(ds, r.coeffs)

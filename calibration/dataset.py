@@ -243,11 +243,13 @@ class Dataset:
                        **{f: getattr(self, f)[idx] for f in _POINT_FIELDS},
                        elastic_sphere=self.elastic_sphere)
 
-    def without_group(self, group: str) -> Dataset:
-        return self.subset([i for i, c in enumerate(self.curves) if c.group != group])
+    def without_groups(self, *groups: str) -> Dataset:
+        """The runs of every material but ``groups``."""
+        return self.subset([i for i, c in enumerate(self.curves) if c.group not in groups])
 
-    def only_group(self, group: str) -> Dataset:
-        return self.subset([i for i, c in enumerate(self.curves) if c.group == group])
+    def only_groups(self, *groups: str) -> Dataset:
+        """The runs of the materials ``groups``."""
+        return self.subset([i for i, c in enumerate(self.curves) if c.group in groups])
 
 
 #: the per-point arrays of a :class:`Dataset` besides ``run``

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..cycles import run_cycles
+from ..fem.increments import smaller_radius
 from ..model.coefficients import Coefficients
 from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
@@ -350,7 +351,7 @@ class FirstLoadingReplaced:
 
     def __init__(self, run, converged: dict, h_end: float):
         self._run = run
-        L = min(float(run.inputs["radius"]), float(run.inputs.get("indenter_radius", math.inf)))
+        L = smaller_radius(run.inputs)
         h, F, a = (np.asarray(v, dtype=float) for v in (run.h, run.F, run.a))
         ref = np.asarray(getattr(run, "reference", np.ones(h.size, bool)), dtype=bool)
         keep = ref & (h > h_end * L * (1.0 + 1e-9))
@@ -368,13 +369,13 @@ def load_converged_first_loading(path) -> tuple[dict, float]:
     return {c["key"]: c for c in d["cases"]}, float(d["h_end"])
 
 
-def replace_first_loading(runs, path) -> tuple[list, list[str]]:
-    """``runs`` (``(name, run)``, names ending in ``[key]``) with the first loading of those the
-    file at ``path`` re-ran replaced (:class:`FirstLoadingReplaced`), and the keys replaced."""
+def replace_first_loading(runs, keys, path) -> tuple[list, list[str]]:
+    """``runs`` (``(name, run)``, database keys ``keys`` in the same order, as :func:`load_runs`
+    gives them) with the first loading of those the file at ``path`` re-ran replaced
+    (:class:`FirstLoadingReplaced`), and the keys replaced."""
     converged, h_end = load_converged_first_loading(path)
     out, done = [], []
-    for name, run in runs:
-        key = name.rsplit("[", 1)[-1].rstrip("]")
+    for (name, run), key in zip(runs, keys, strict=True):
         if key in converged:
             run = FirstLoadingReplaced(run, converged[key], h_end)
             done.append(key)
@@ -549,7 +550,7 @@ def calibrate(db_path, out=None, report_dir=None, include_stopped: bool = True,
         db = Database(db_path)  # opened once: listing its entries reads every run's attributes
         runs, source = load_runs(db_path, include_stopped, db=db, content_hash=False)
         if converged_fe is not None:
-            runs, replaced = replace_first_loading(runs, converged_fe)
+            runs, replaced = replace_first_loading(runs, [r["key"] for r in source["runs"]], converged_fe)
             source["first_loading_replaced"] = {"path": source_path(converged_fe), "runs": len(replaced)}
         two = two_body_runs(db)
         pairs = load_pairs(db_path, runs=two)

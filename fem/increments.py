@@ -41,12 +41,17 @@ RELATIVE_STEP = 0.03
 A_RESOLVED = 0.01
 
 
+def smaller_radius(inputs: dict) -> float:
+    """The body's radius or its rigid partner's, the smaller: the length of ``H_END``."""
+    return min(float(inputs["radius"]), float(inputs.get("indenter_radius", math.inf)))
+
+
 def rerun(inputs: dict, relative_step: float):
     """The first loading of a stored one-body case, increments dh ≤ ``relative_step`` · h."""
-    Ri = float(inputs.get("indenter_radius", math.inf))
-    R = float(inputs["radius"])
-    return run_indentation(material_from_description(inputs["material"]), R, H_END * min(R, Ri),
-                           indenter_radius=Ri, edge_band=float(inputs.get("edge_band", 0.0)),
+    return run_indentation(material_from_description(inputs["material"]), float(inputs["radius"]),
+                           H_END * smaller_radius(inputs),
+                           indenter_radius=float(inputs.get("indenter_radius", math.inf)),
+                           edge_band=float(inputs.get("edge_band", 0.0)),
                            band_floor=inputs.get("band_floor"),
                            options=SolverOptions(relative_step=relative_step))
 
@@ -65,8 +70,8 @@ def measure(db: Database, case: str, relative_step: float) -> dict:
     rec = next(r for r in db.records() if r.case == case)
     run = db.run(rec.key)
     old = {"h": np.asarray(run.h), "F": np.asarray(run.F), "a": np.asarray(run.a)}
-    keep = loading_mask(run.curves) & np.asarray(getattr(run, "reference", np.ones(old["h"].size, bool)))
-    L = min(float(rec.inputs["radius"]), float(rec.inputs.get("indenter_radius", math.inf)))
+    keep = np.asarray(run.reference)  # loading increments without a first step's transient
+    L = smaller_radius(rec.inputs)
     t = time.perf_counter()
     new = rerun(rec.inputs, relative_step)
     wall = time.perf_counter() - t

@@ -169,7 +169,7 @@ def test_dropping_a_material_keeps_the_fit_stable_synthetic():
     full = fit(ds, FORMS["smooth"])
     for g in ("E/sy=1000 nu=0.3 K/sy=2 n=0.5", "E/sy=300 nu=0.3", "E/sy=10 nu=0.3"):
         assert g in ds.groups
-        part = fit(ds.without_group(g), FORMS["smooth"], start=full.params)
+        part = fit(ds.without_groups(g), FORMS["smooth"], start=full.params)
         assert _prediction_shift(ds, full.coeffs, part.coeffs) < STABLE_SHIFT_SYNTH, g
         for k in ("H_bar_III", "c2_III"):
             assert part.coeff_dict[k]["prefactor"] == pytest.approx(
@@ -198,7 +198,7 @@ def test_dropping_a_material_keeps_the_fit_stable_on_the_shipped_database():
     # the material of the middle of the perfectly plastic range and a linear-hardening one
     for g in ("E/sy=316 nu=0.3", "E/sy=1000 nu=0.3 K/sy=5 n=1"):
         assert g in ds.groups, g
-        part = fit(ds.without_group(g), form, start=full.params)
+        part = fit(ds.without_groups(g), form, start=full.params)
         pa, ca = predict(ds, full.coeffs)
         pb, cb = predict(ds, part.coeffs)
         shift = np.concatenate([pb / pa - 1, cb / ca - 1])
@@ -388,16 +388,17 @@ def test_a_converged_first_loading_replaces_the_run_s_own(small_db, tmp_path):
     from a re-run with finer increments; the rest of the curve is the run's, and the coefficient
     file says how many runs were replaced."""
     from spherecontact.calibration.pipeline import coefficient_file, replace_first_loading
+    from spherecontact.fem.increments import smaller_radius
 
-    runs, _ = load_runs(small_db, content_hash=False)
-    name, run = runs[0]
-    key = name.rsplit("[", 1)[-1].rstrip("]")
-    L = min(float(run.inputs["radius"]), float(run.inputs.get("indenter_radius", math.inf)))
+    runs, source = load_runs(small_db, content_hash=False)
+    keys = [r["key"] for r in source["runs"]]
+    run, key = runs[0][1], keys[0]
+    L = smaller_radius(run.inputs)
     hc = np.geomspace(1e-5, 0.01, 40) * L
     curve = {"h": hc.tolist(), "F": (2.0 * hc).tolist(), "a": np.sqrt(hc).tolist()}
     path = tmp_path / "increments_calibration.json"
     path.write_text(json.dumps({"h_end": 0.01, "cases": [{"key": key, "curve": curve}]}))
-    new, replaced = replace_first_loading(runs, path)
+    new, replaced = replace_first_loading(runs, keys, path)
     assert replaced == [key] and [n for n, _ in new] == [n for n, _ in runs]
     r = new[0][1]
     head = r.h <= 0.01 * L * (1 + 1e-9)
