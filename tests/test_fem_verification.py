@@ -1,0 +1,39 @@
+"""The FE verification's plan and helpers (the runs themselves: ``make verify-fem``)."""
+
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spherecontact.fem.verification import CAMPAIGN_BAND, LOCK_WINDOW, _run, _window_mean, plan
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_window_mean_is_the_trapezoidal_mean_over_the_window():
+    h = np.linspace(0.0, 0.002, 21)
+    y = 3.0 + 1000.0 * h  # linear: the mean over the increments 0.0006 … 0.0012 is its middle value
+    assert _window_mean(h, y, 0.00055, 0.00125) == pytest.approx(3.0 + 1000.0 * 0.0009, rel=1e-12)
+    steps = np.where(np.arange(h.size) % 2 == 0, 2.9, 3.1)  # ±0.1 about 3: averaged out
+    assert abs(_window_mean(h, steps, 0.0002, 0.0018) - 3.0) < 0.01
+    assert np.isnan(_window_mean(h, y, 0.00051, 0.00059))  # no increment inside: no figure
+
+
+def test_verification_checks_the_mesh_the_campaign_runs_on():
+    """The locking check on the surface band follows the campaign's band: a campaign that
+    changes it must change the verification too."""
+    campaign = tomllib.loads((ROOT / "data" / "campaign_v2.toml").read_text())
+    assert CAMPAIGN_BAND == campaign["defaults"]["edge_band"]
+    full, quick = plan(quick=False), plan(quick=True)
+    for runs in (full, quick):
+        assert runs["lock_band"]["edge_band"] == runs["lock_band_fine"]["edge_band"] == CAMPAIGN_BAND
+        assert runs["lock_band_fine"]["density"] > runs["lock_band"].get("density", 1.0)
+        assert runs["lock_band"]["h_max"] >= LOCK_WINDOW[1]  # the window lies inside the run
+
+
+def test_run_builds_the_band_mesh_it_is_given():
+    plain = _run("elastic", 200.0, 2e-4, options=dict(dh_first=1e-4, dh_max=1e-4))
+    band = _run("elastic", 200.0, 2e-4, edge_band=CAMPAIGN_BAND, options=dict(dh_first=1e-4, dh_max=1e-4))
+    assert band["n_dofs"] > plain["n_dofs"]
+    assert band["status"] == plain["status"] == "converged"
