@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from _meshes import smallest_surface_element
 
+from spherecontact.fem import segments
 from spherecontact.fem.io import choose_scene, read_run, run_indentation, write_run
 from spherecontact.fem.segments import gap_gradient, gap_hessian
 from spherecontact.model.material import Material
@@ -50,6 +51,21 @@ def test_gap_gradient_and_hessian_match_finite_differences():
         fdh = (gap_gradient(Cp, 1.0)[1] - gap_gradient(Cm, 1.0)[1]) / (2 * eps)
         np.testing.assert_allclose(H[:, j], fdh, atol=1e-6)
     np.testing.assert_allclose(H, H.transpose(1, 0, 2), atol=1e-12)
+
+
+def test_early_stopped_projection_equals_the_fully_iterated_one(monkeypatch):
+    """The projection stops at PROJECTION_TOL; gap, gradient and complex-step Hessian are those
+    of Newton iterated far past convergence to round-off, also for t outside [0, 1]."""
+    C = _arc_pairs(n=40, seed=3)
+    C[0] = np.linspace(0.03, 0.22, C.shape[1])  # t from about −0.4 to 1.4
+    C[1] = np.cos(C[0]) - 1.0 + np.linspace(-1e-2, 1e-2, C.shape[1])
+    fast = gap_gradient(C, 1.0), gap_hessian(C, 1.0)
+    monkeypatch.setattr(segments, "PROJECTION_TOL", 0.0)
+    monkeypatch.setattr(segments, "PROJECTION_ITERATIONS", 30)
+    full = gap_gradient(C, 1.0), gap_hessian(C, 1.0)
+    assert np.ptp(full[0][2]) > 1.5
+    for a, b in zip(fast[0] + (fast[1],), full[0] + (full[1],), strict=True):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.abs(b).max())
 
 
 @pytest.mark.parametrize("kw, scene", [
