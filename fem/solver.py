@@ -1006,15 +1006,15 @@ class IndentationSolver(CycleLegs):
         (F, real stress update, internal force) for the next iteration.
         """
         if not self.options.line_search:
-            return self._admissible(u, du), None
+            return self._admissible(u, du)[0], None
         duf = self._rotate(du, frames)[free]
         s0 = float(np.dot(duf, r0))
         if s0 >= 0.0:
-            return self._admissible(u, du), None
+            return self._admissible(u, du)[0], None
         alpha, lo, s_lo = 1.0, 0.0, s0
         for _ in range(max_steps):
-            trial, alpha = self._admissible(u, alpha * du, with_alpha=True, base_alpha=alpha)
-            Fv = self.disc.deformation_gradient(trial)
+            trial, beta, Fv = self._admissible(u, alpha * du)
+            alpha *= beta
             real = stress_update(Fv, state.cp_inv, state.eps_p, self.material, elastic=self._elastic)
             f = self.disc.internal_force(real.P)
             known = (Fv, real, f)
@@ -1032,12 +1032,15 @@ class IndentationSolver(CycleLegs):
             alpha = float(np.clip(new, 0.1 * alpha, alpha))
         return trial, known  # the last admissible step tried
 
-    def _admissible(self, u, du, halvings: int = 6, with_alpha: bool = False, base_alpha: float = 1.0):
-        """u + β du with the largest β = 2^-k keeping every Jacobian positive."""
+    def _admissible(self, u, du, halvings: int = 6):
+        """(u + β du, β, F there) with the largest β = 2^-k keeping every Jacobian positive (F
+        for the line search's stress update, not computed twice)."""
         beta = 1.0
         for _ in range(halvings + 1):
-            if positive_jacobian(self.disc.deformation_gradient(u + beta * du)):
-                return (u + beta * du, base_alpha * beta) if with_alpha else u + beta * du
+            trial = u + beta * du
+            Fv = self.disc.deformation_gradient(trial)
+            if positive_jacobian(Fv):
+                return trial, beta, Fv
             beta *= 0.5
         raise IncrementFailed("inverted element (J <= 0) even after step halving")
 
