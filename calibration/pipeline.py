@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from ..cycles import run_cycles
-from ..fem.increments import smaller_radius
+from ..fem.increments import read_reruns, smaller_radius
 from ..model.coefficients import Coefficients
 from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
@@ -363,17 +363,12 @@ class FirstLoadingReplaced:
         return getattr(self._run, name)
 
 
-def load_converged_first_loading(path) -> tuple[dict, float]:
-    """``(key → re-run case, h_end)`` of a ``fem/increments.py`` file (``--converged-fe``)."""
-    d = json.loads(Path(path).read_text())
-    return {c["key"]: c for c in d["cases"]}, float(d["h_end"])
-
-
 def replace_first_loading(runs, keys, path) -> tuple[list, list[str]]:
     """``runs`` (``(name, run)``, database keys ``keys`` in the same order, as :func:`load_runs`
     gives them) with the first loading of those the file at ``path`` re-ran replaced
     (:class:`FirstLoadingReplaced`), and the keys replaced."""
-    converged, h_end = load_converged_first_loading(path)
+    converged, head = read_reruns(path)
+    h_end = float(head["h_end"])
     out, done = [], []
     for (name, run), key in zip(runs, keys, strict=True):
         if key in converged:

@@ -46,6 +46,14 @@ def smaller_radius(inputs: dict) -> float:
     return min(float(inputs["radius"]), float(inputs.get("indenter_radius", math.inf)))
 
 
+def read_reruns(path) -> tuple[dict, dict]:
+    """``(key → re-run case, header)`` of a file :func:`main` wrote; the header holds ``h_end``,
+    ``date_utc``, ``db`` and ``note`` (what the calibration's ``--converged-fe`` and the validation's
+    small-contact section read)."""
+    d = json.loads(Path(path).read_text())
+    return {c["key"]: c for c in d.pop("cases")}, d
+
+
 def rerun(inputs: dict, relative_step: float):
     """The first loading of a stored one-body case, increments dh ≤ ``relative_step`` · h."""
     return run_indentation(material_from_description(inputs["material"]), float(inputs["radius"]),

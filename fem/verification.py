@@ -237,7 +237,7 @@ def evaluate(runs: dict, quick: bool) -> dict:
     change = lambda fine, coarse, q: lock[fine][q] / lock[coarse][q] - 1  # noqa: E731
     lock["q8r_mesh_change"] = change("lock_q8r_fine", "lock_q8r", "p_m_over_sy")
     lock["q8r_mesh_change_window"] = change("lock_q8r_fine", "lock_q8r", "p_m_window_mean")
-    lock["q4_over_q8r"] = lock["lock_q4"]["p_m_over_sy"] / lock["lock_q8r_fine"]["p_m_over_sy"] - 1
+    lock["q4_over_q8r"] = change("lock_q4", "lock_q8r_fine", "p_m_over_sy")
     lock["band_mesh_change"] = change("lock_band_fine", "lock_band", "p_m_over_sy")
     lock["band_mesh_change_window"] = change("lock_band_fine", "lock_band", "p_m_window_mean")
     lock["window_h_over_R"] = list(LOCK_WINDOW)
@@ -380,19 +380,18 @@ def _report(figures: dict, pngs: list[str], outdir: Path, wall: float, quick: bo
                  f"≤ {MAX_ITERATIONS_PER_INCREMENT:g} | median {n['convergence_order_median']:.2f}, {n['iterations_per_increment']:.2f} it/increment | "
                  f"{n['iterations_per_increment'] <= MAX_ITERATIONS_PER_INCREMENT} |")
     lk = figures["locking"]
-    lo, hi = lk.get("window_h_over_R", LOCK_WINDOW)
+    lo, hi = lk["window_h_over_R"]
     lines.append(f"| locking, EPP E/σY=10⁴, Λ ≈ {lk['lock_q8r']['Lambda']:.0f}, default mesh | p_m mesh-converged (≤ 1 %) | "
                  f"Q8R p_m/σY {lk['lock_q8r']['p_m_over_sy']:.3f} → {lk['lock_q8r_fine']['p_m_over_sy']:.3f} "
                  f"({100 * lk['q8r_mesh_change']:+.2f} %; mean over h/R {lo:g}–{hi:g} "
                  f"{100 * lk['q8r_mesh_change_window']:+.2f} %); Q4 full integration {lk['lock_q4']['p_m_over_sy']:.3f} → "
                  f"{lk['lock_q4_fine']['p_m_over_sy']:.3f} ({100 * lk['q4_over_q8r']:+.1f} % vs Q8R) | {lk['pass']} |")
-    if "lock_band" in lk:
-        b, bf = lk["lock_band"], lk["lock_band_fine"]
-        lines.append(f"| locking, the same on the campaigns' surface-band mesh ({CAMPAIGN_BAND:g}) | p_m mean over "
-                     f"h/R {lo:g}–{hi:g} mesh-converged (≤ 1 %) | {b['p_m_window_mean']:.3f} → "
-                     f"{bf['p_m_window_mean']:.3f} ({100 * lk['band_mesh_change_window']:+.2f} %; last increment "
-                     f"{b['p_m_over_sy']:.3f} → {bf['p_m_over_sy']:.3f}, {100 * lk['band_mesh_change']:+.2f} %; "
-                     f"{b['n_dofs']} → {bf['n_dofs']} dofs) | {lk['pass_band']} |")
+    b, bf = lk["lock_band"], lk["lock_band_fine"]
+    lines.append(f"| locking, the same on the campaigns' surface-band mesh ({CAMPAIGN_BAND:g}) | p_m mean over "
+                 f"h/R {lo:g}–{hi:g} mesh-converged (≤ 1 %) | {b['p_m_window_mean']:.3f} → "
+                 f"{bf['p_m_window_mean']:.3f} ({100 * lk['band_mesh_change_window']:+.2f} %; last increment "
+                 f"{b['p_m_over_sy']:.3f} → {bf['p_m_over_sy']:.3f}, {100 * lk['band_mesh_change']:+.2f} %; "
+                 f"{b['n_dofs']} → {bf['n_dofs']} dofs) | {lk['pass_band']} |")
     e = figures["energy"]
     lines.append(f"| energy W = E_el + D (h/R ≥ 0.01) | ≤ 1 % | max {100 * e['balance_rel_err_max_h_ge_0.01']:.2f} %, "
                  f"end {100 * e['balance_rel_err_end']:+.2f} % | {e['pass']} |")

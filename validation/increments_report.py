@@ -11,11 +11,11 @@ thresholds are read against the stored curves as before; this section decides no
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
+from ..fem.increments import read_reruns
 from .compare import W_ACCEPT, Comparison
 from .metrics import interp_loglog
 
@@ -31,11 +31,11 @@ def load_converged(path=DEFAULT_PATH) -> dict | None:
     path = Path(path)
     if not path.exists():
         return None
-    d = json.loads(path.read_text())
-    out = {c["key"]: (np.asarray(c["curve"]["h"]), np.asarray(c["curve"]["F"])) for c in d["cases"]}
-    steps = {c["relative_step"] for c in d["cases"]}
-    out["_meta"] = {"h_end": float(d["h_end"]), "relative_step": steps.pop() if len(steps) == 1 else None,
-                    "date": d.get("date_utc"), "path": str(path)}
+    cases, head = read_reruns(path)
+    out = {k: (np.asarray(c["curve"]["h"]), np.asarray(c["curve"]["F"])) for k, c in cases.items()}
+    steps = {c["relative_step"] for c in cases.values()}
+    out["_meta"] = {"h_end": float(head["h_end"]), "relative_step": steps.pop() if len(steps) == 1 else None,
+                    "date": head.get("date_utc"), "path": str(path)}
     return out
 
 
