@@ -524,18 +524,28 @@ class CollapseLimitAtZ:
 
     def log_slope_and_dn(self, x, n, x_max: float | None = None):
         """ln L, d ln L/d ln x and ∂ln L/∂n at (x, n) (vectorised, x > 0)."""
-        x = np.asarray(x, dtype=float)
-        n = np.asarray(n, dtype=float)
-        xc, u, ln_xc = continued_log(x, x_max)
+        return self.with_n(self.x_terms(x, x_max), n)
+
+    def x_terms(self, x, x_max: float | None = None) -> tuple[np.ndarray, ...]:
+        """The terms of :meth:`log_slope_and_dn` that do not move with n, at x: log_const
+        − exponent ln x + Σ x_poly[k] x^(k+1), its log slope, Σ xn_poly[k] x^(k+1) and its log
+        slope (continued beyond x_max)."""
+        xc, u, ln_xc = continued_log(np.asarray(x, dtype=float), x_max)
         s, ds = _poly_and_slope(xc, self.x_poly)
         sn, dsn = _poly_and_slope(xc, self.xn_poly)
         if x_max is not None:
             s, ds = s + (ds - self.exponent) * (1.0 - u), ds * u + self.exponent * (1.0 - u)
             sn, dsn = sn + dsn * (1.0 - u), dsn * u
-        e, de = exp_poly_log_and_slope(self.exp_poly, n)
         power = self.exponent * ln_xc if self.exponent else 0.0
-        lnL = self.log_const - power + s + e + n * (sn + self.zn_sum)
-        return lnL, ds - self.exponent + n * dsn, de + sn + self.zn_sum
+        return self.log_const - power + s, ds - self.exponent, sn, dsn
+
+    def with_n(self, terms: tuple[np.ndarray, ...], n):
+        """ln L, d ln L/d ln x and ∂ln L/∂n from the x-terms (:meth:`x_terms`) and n:
+        ln L = (x-terms) + E(n) + n (Σ xn_poly[k] x^(k+1) + zn_sum)."""
+        base, slope, sn, dsn = terms
+        n = np.asarray(n, dtype=float)
+        e, de = exp_poly_log_and_slope(self.exp_poly, n)
+        return base + e + n * (sn + self.zn_sum), slope + n * dsn, de + sn + self.zn_sum
 
 
 @dataclass(frozen=True)

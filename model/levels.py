@@ -61,6 +61,8 @@ __all__ = [
     "ONSET_YIELD_WEIGHT",
     "stage",
     "finite_size_by_level",
+    "finite_size_terms",
+    "finite_size_blend",
     "collapse_blend",
     "collapse_pressure",
     "CollapseBlend",
@@ -494,13 +496,28 @@ def finite_size_by_level(x, s, ds, elastic: tuple[float, ...], plastic: tuple[fl
     -------
     f, d ln f/d ln x, d ln f/d ln Λ.
     """
+    return finite_size_blend(finite_size_terms(x, elastic, plastic, x_max), s, ds)
+
+
+def finite_size_terms(x, elastic: tuple[float, ...], plastic: tuple[float, ...],
+                      x_max: float | None = None) -> tuple[np.ndarray, ...]:
+    """The factors of :func:`finite_size_by_level` at x, which do not move with the level weight:
+    (f_e, d ln f_e/d ln x, f_p, d ln f_p/d ln x), or (f, d ln f/d ln x) when elastic = plastic."""
     x = np.asarray(x, dtype=float)
     if elastic == plastic:
-        f, dx = finite_size_factor(x, elastic, x_max)
-        return f, dx, np.zeros_like(f)
+        return finite_size_factor(x, elastic, x_max)
     xc, u = continue_beyond(x, x_max)  # one continuation for both
-    fe, de = _factor_continued(xc, u, elastic, x_max is not None)
-    fp, dp = _factor_continued(xc, u, plastic, x_max is not None)
+    return (*_factor_continued(xc, u, elastic, x_max is not None),
+            *_factor_continued(xc, u, plastic, x_max is not None))
+
+
+def finite_size_blend(terms: tuple[np.ndarray, ...], s, ds):
+    """f, d ln f/d ln x and d ln f/d ln Λ of :func:`finite_size_by_level` from its factors at x
+    (:func:`finite_size_terms`) and the level weight s, ds/d ln Λ: f = (1 − s) f_e + s f_p."""
+    if len(terms) == 2:
+        f, dx = terms
+        return f, dx, np.zeros_like(f)
+    fe, de, fp, dp = terms
     f = (1.0 - s) * fe + s * fp
     return f, ((1.0 - s) * fe * de + s * fp * dp) / f, (fp - fe) * ds / f
 

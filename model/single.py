@@ -56,7 +56,8 @@ from .levels import (
     collapse_blend,
     collapse_pressure,
     counter_surface,
-    finite_size_by_level,
+    finite_size_blend,
+    finite_size_terms,
     level_t,
     level_weight,
     levels_scalar_n,
@@ -80,6 +81,7 @@ __all__ = [
     "capped_exponent",
     "hardening_magnitude",
     "BodyResponse",
+    "FixedTerms",
     "BodyLaw",
     "IndentState",
     "indent",
@@ -292,6 +294,25 @@ class BodyResponse(NamedTuple):
     piece: np.ndarray      # smooth-piece id (level, flow-table segment, continuation); kinks where it changes
 
 
+class FixedTerms(NamedTuple):
+    """The terms of :meth:`BodyLaw.response` that move with the finite-size ratio y and the
+    counter-surface ratio xc alone (both are a over a constant of the pair): a κ solve moves
+    x = a/ρ at fixed a (``unified.py``) and reads them at every iterate. Each field is a tuple of
+    arrays shaped like y, or None (a term the coefficient set lacks, or the c² terms of a
+    pressure-only response)."""
+
+    fs_H: tuple | None         # finite-size factors of H̄ at y (``levels.finite_size_terms``)
+    fs_c2: tuple | None
+    counter_H: tuple | None    # exp(q_H s(u)) and its two d/d ln y terms (u = xc − y)
+    counter_c2: tuple | None
+    collapse_H: tuple | None   # y-terms of the collapse limit H̄_c (``CollapseLimitAtZ.x_terms``)
+    collapse_c2: tuple | None
+
+    def take(self, idx) -> FixedTerms:
+        """The terms at the points ``idx``."""
+        return FixedTerms(*(None if f is None else tuple(v[idx] for v in f) for f in self))
+
+
 @dataclass(frozen=True)
 class BodyLaw:
     """Single-body law p_m(x), c²(x) of one deformable material (DESIGN §2)."""
@@ -384,8 +405,37 @@ class BodyLaw:
             Lam = mat.E_prime * x / representative_stress(mat, eps, co.strain_spread)[0]
         return self._piece(Lam, eps, y, x)
 
-    def response(self, x, y=None, z: float = 0.0, xc=None,
-                 pressure_only: bool = False, level_c=None) -> BodyResponse:
+    def fixed_terms(self, y, z: float = 0.0, xc=None, level_c=None, with_c2: bool = True) -> FixedTerms:
+        """The terms of :meth:`response` that do not move with x at finite-size ratio y, curvature
+        ratio z and counter-surface ratio xc (:class:`FixedTerms`; the counter-surface terms only
+        with xc, else they read x); ``level_c``: the level weight and its slope at xc if at hand;
+        ``with_c2`` False: the c² terms are None."""
+        co, xm = self.coeffs, self.x_fit_max
+        y = np.asarray(y, dtype=float)
+        fs_H = finite_size_terms(y, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
+        fs_c2 = finite_size_terms(y, co.finite_size_c2, co.fs_c2_plastic, xm) if with_c2 else None
+        counter = (None, None)
+        if co.has_counter_surface and xc is not None:
+            xc = np.asarray(xc, dtype=float)
+            su, su_x, su_y = counter_surface(xc, y)
+            s_c, ds_c = self.level_state_at(xc) if level_c is None else level_c
+            # exp(q s(u)) and its d/d ln y, q s_y + (dq/ds) s(u) ds_c/d ln a (q(s_c), z: the pair's)
+            counter = tuple((np.exp(q * su), q * (su_x + su_y), dq * su * ds_c)
+                            for q, dq in co.counter_by_level(s_c, z))
+        collapse = (None, None)
+        if co.has_collapse and co.exponent_local and not math.isinf(self.material.sigma_y):
+            lim_H, lim_c = self._collapse_limits(z)
+            collapse = (lim_H.x_terms(y, xm), lim_c.x_terms(y, xm) if with_c2 else None)
+        return FixedTerms(fs_H, fs_c2, counter[0], counter[1] if with_c2 else None, *collapse)
+
+    def _collapse_limits(self, z):
+        """The collapse limits of H̄ and c² at curvature ratio z with n free (``CollapseLimit.at_z``)."""
+        co = self.coeffs
+        zv, zm = float(co.collapse_z(z)), float(co.collapse_z(co.z_fit_max))
+        return co.collapse_H_bar.at_z(zv, zm), co.collapse_c2.at_z(zv, zm)
+
+    def response(self, x, y=None, z: float = 0.0, xc=None, pressure_only: bool = False,
+                 level_c=None, fixed: FixedTerms | None = None) -> BodyResponse:
         """Evaluate at x = a/ρ; ``y`` is the finite-size ratio (defaults to x, i.e. a/ρ);
         ``z`` the curvature ratio of the collapse limits (a constant of the pair,
         :func:`curvature_ratio`); ``xc`` the contact radius over the body's Hertz relative
@@ -399,7 +449,9 @@ class BodyLaw:
         the same reason: read at x it left 27 of 300 random plastic pairs without a consistent root
         from h/R ≈ 0.32 on. ``pressure_only``: p_m and its slopes alone (what the κ solve reads;
         c², its slopes and the piece are None), without the c² terms' cost. ``level_c``: the
-        level weight and its slope at ``xc`` (:meth:`level_state_at`) when the caller has them."""
+        level weight and its slope at ``xc`` (:meth:`level_state_at`) when the caller has them;
+        ``fixed``: the terms that do not move with x (:meth:`fixed_terms` at y, z, xc, with c² unless
+        ``pressure_only``) when the caller has them (a κ solve reads them at every iterate)."""
         mat, co = self.material, self.coeffs
         x = np.asarray(x, dtype=float)
         y = x if y is None else np.asarray(y, dtype=float)
@@ -428,38 +480,41 @@ class BodyLaw:
         with np.errstate(invalid="ignore"):
             p = np.where(lev == 1, _HERTZ * Ep * x, H * sig)
         s_l, ds_l = level_weight(Lam, co, t)
-        xm = self.x_fit_max
-        fH, dfH, lfH = finite_size_by_level(y, s_l, ds_l, co.finite_size_H_bar, co.fs_H_bar_plastic, xm)
+        if fixed is None:
+            fixed = self.fixed_terms(y, z, xc, level_c, with_c2)
+        fH, dfH, lfH = finite_size_blend(fixed.fs_H, s_l, ds_l)
         p = p * fH
         dp_x, dp_y = (sH + lfH) * (1.0 - m) + m, dfH
         if local:
             dp_x = dp_x + H_n * n_x
         piece = dc_x = dc_y = None
         if with_c2:
-            fc, dfc, lfc = finite_size_by_level(y, s_l, ds_l, co.finite_size_c2, co.fs_c2_plastic, xm)
+            fc, dfc, lfc = finite_size_blend(fixed.fs_c2, s_l, ds_l)
             piece = self._piece(Lam, eps, y, x)
             c = c * fc
             dc_x, dc_y = (sc + lfc) * (1.0 - m), dfc
             if local:
                 dc_x = dc_x + c_n * n_x
-        if co.has_counter_surface:  # exp(q s(u)), u = x − y (``levels.counter_surface``)
-            if xc is None:
-                su, su_x, su_y = counter_surface(x, y)
-                s_c, lev_x, lev_y = s_l, ds_l * (1.0 - m), 0.0  # level weight, d/d ln x, d/d ln y
-            else:  # u = xc − y moves with a only: every slope in the y slot, the level weight too
-                su, su_x, su_y = counter_surface(np.asarray(xc, dtype=float), y)
-                su_x, su_y = 0.0, su_x + su_y
-                s_c, ds_c = self.level_state_at(np.asarray(xc, dtype=float)) if level_c is None else level_c
-                lev_x, lev_y = 0.0, ds_c
-            (qH, dqH), (qc, dqc) = co.counter_by_level(s_c, z)  # q(s), dq/ds (z: a constant of the pair)
+        if co.has_counter_surface and xc is None:  # exp(q s(u)), u = x − y (``levels.counter_surface``)
+            su, su_x, su_y = counter_surface(x, y)
+            lev_x = ds_l * (1.0 - m)  # the level weight's d/d ln x (its d/d ln y is 0)
+            (qH, dqH), (qc, dqc) = co.counter_by_level(s_l, z)  # q(s), dq/ds (z: a constant of the pair)
             p = p * np.exp(qH * su)
-            dp_x, dp_y = dp_x + qH * su_x + dqH * su * lev_x, dp_y + qH * su_y + dqH * su * lev_y
+            dp_x, dp_y = dp_x + qH * su_x + dqH * su * lev_x, dp_y + qH * su_y
             if with_c2:
                 c = c * np.exp(qc * su)
-                dc_x, dc_y = dc_x + qc * su_x + dqc * su * lev_x, dc_y + qc * su_y + dqc * su * lev_y
+                dc_x, dc_y = dc_x + qc * su_x + dqc * su * lev_x, dc_y + qc * su_y
+        elif co.has_counter_surface:  # u = xc − y moves with a only: its terms are fixed (x slopes 0)
+            factor, dy_su, dy_level = fixed.counter_H
+            p = p * factor
+            dp_y = dp_y + dy_su + dy_level
+            if with_c2:
+                factor, dy_su, dy_level = fixed.counter_c2
+                c = c * factor
+                dc_y = dc_y + dy_su + dy_level
         if co.has_collapse and local:
-            return self._collapse_local(p, sig, m, c, y, n, n_x, z, Lam, piece,
-                                        (dp_x, dp_y), (dc_x, dc_y))
+            return self._collapse_local(p, sig, m, c, n, n_x, z, Lam, piece,
+                                        (dp_x, dp_y), (dc_x, dc_y), fixed)
         if co.has_collapse and not math.isinf(mat.sigma_y):
             if not with_c2:
                 Hb, w, dlnHc = collapse_pressure(p / sig, y, co, self.n_eff, z)
@@ -482,13 +537,14 @@ class BodyLaw:
             dlnc2_dlnx=dc_x, dlnc2_dlny=dc_y, piece=piece,
         )
 
-    def _collapse_local(self, p, sig, m, c, y, n, n_x, z, Lam, piece, dp, dc) -> BodyResponse:
+    def _collapse_local(self, p, sig, m, c, n, n_x, z, Lam, piece, dp, dc, fixed) -> BodyResponse:
         """The collapse blend of :meth:`response` with n read along the curve: the limits'
         n-terms move with x, ∂ln H̄_c/∂ln x += (∂ln H̄_c/∂n) n_x (likewise c²_c), in the x slot
-        (``levels.collapse_blend``'s equations; the limits at the pair's z, ``CollapseLimit.at_z``)."""
+        (``levels.collapse_blend``'s equations; the limits at the pair's z, ``CollapseLimit.at_z``,
+        their y-terms from ``fixed``)."""
         co = self.coeffs
-        zv, zm, xm = float(co.collapse_z(z)), float(co.collapse_z(co.z_fit_max)), co.x_fit_max
-        lnHc, sHc, Hc_n = co.collapse_H_bar.at_z(zv, zm).log_slope_and_dn(y, n, xm)
+        lim_H, lim_c = self._collapse_limits(z)
+        lnHc, sHc, Hc_n = lim_H.with_n(fixed.collapse_H, n)
         (dp_x, dp_y), (dc_x, dc_y) = dp, dc
         if c is None:  # pressure only: the H̄ half of the blend (``levels.collapse_pressure``)
             Hb, w, _ = blend_pressure(p / sig, lnHc, co.collapse_sharpness)
@@ -496,7 +552,7 @@ class BodyLaw:
                                 dlnp_dlnx=(1.0 - w) * dp_x + w * (m + Hc_n * n_x),
                                 dlnp_dlny=(1.0 - w) * dp_y + w * sHc,
                                 dlnc2_dlnx=None, dlnc2_dlny=None, piece=None)
-        lncc, scc, cc_n = co.collapse_c2.at_z(zv, zm).log_slope_and_dn(y, n, xm)
+        lncc, scc, cc_n = lim_c.with_n(fixed.collapse_c2, n)
         Hb, c2, w, gap, wc = blend_from_logs(p / sig, c, lnHc, lncc, co.collapse_sharpness,
                                              co.collapse_sharpness_c2, co.collapse_offset_c2)
         dr_x, dr_y = dp_x - m - Hc_n * n_x, dp_y - sHc  # ∂ln r

@@ -72,7 +72,7 @@ from .cap import cap_gap_factor
 from .coefficients import Coefficients, default_coefficients
 from .profile import profile_factor
 from .roots import solve_increasing
-from .single import BodyLaw, BodyResponse, curvature_ratio
+from .single import BodyLaw, BodyResponse, FixedTerms, curvature_ratio
 from .sphere import Sphere
 
 __all__ = ["UnifiedState", "UnifiedPair", "Domain", "pair"]
@@ -134,6 +134,18 @@ _PREDICT = 1.0
 _MODULUS_RATIO = 0.1
 #: ln a step of the grid on which a pair's similarity factor is checked once (``_similar_somewhere``)
 _SIMILAR_STEP = 0.02
+
+
+class _BodyFixed(NamedTuple):
+    """One body's response terms that move with a alone (:meth:`UnifiedPair._fixed_at`)."""
+
+    terms: FixedTerms
+    profile: tuple | None  # pressure-profile factor 1/φ and d ln(1/φ)/d ln a
+
+    def take(self, idx) -> _BodyFixed:
+        """The terms at the points ``idx``."""
+        return _BodyFixed(self.terms.take(idx), None if self.profile is None else
+                          tuple(v[idx] for v in self.profile))
 
 
 def _num(x: float) -> str:
@@ -232,40 +244,64 @@ class UnifiedPair:
             self._cap[id(law)] = (s_o.radius, (1.0 if s_o.is_rigid else w) if exact else 0.0)
         # the partner whose pressure profile each body is loaded by (``profile.py``; a/R ratio only:
         # the factor depends on a alone, which the y slot of the slopes carries)
-        self._profile, self._levels_c = {}, {}
+        self._profile = {}
+        self._fixed = None  # (a, terms) of the last :meth:`_fixed_at`
         if self.mode == "general" and self.coeffs.pressure_profile == "flattened" and not self._ratio_rho:
             self._profile = {id(self.law1): self.law2, id(self.law2): self.law1}
 
     # ------------------------------------------------------------------ body responses
-    def _body(self, law: BodyLaw, a, k, R, pressure_only: bool = False) -> BodyResponse:
+    def _body(self, law: BodyLaw, a, k, R, pressure_only: bool = False, fixed=None) -> BodyResponse:
+        """Body ``law``'s response at contact radius a and 1/ρ = k (``fixed``: its terms of
+        :meth:`_fixed_at` at a, if at hand), times the pressure-profile factor."""
         x = a * k
         y = x if self._ratio_rho else a / R
-        other = self._profile.get(id(law))
-        if other is None:
-            return law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only)
-        own = self._level_at_c(law, a)  # the response reads it too (counter-surface weight)
-        r = law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only, own)
-        ln_q, dln_q = profile_factor(*own, *self._level_at_c(other, a))
-        return r._replace(p_m=r.p_m * np.exp(ln_q), dlnp_dlny=r.dlnp_dlny + dln_q)
+        if fixed is None:
+            fixed = self._fixed_at(a)
+            fixed = None if fixed is None else fixed[id(law)]
+        terms, profile = (None, None) if fixed is None else fixed
+        r = law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only, fixed=terms)
+        if profile is None:
+            return r
+        q, dln_q = profile
+        return r._replace(p_m=r.p_m * q, dlnp_dlny=r.dlnp_dlny + dln_q)
 
-    def _level_at_c(self, law: BodyLaw, a):
-        """The body's level weight and its slope at a/ρ_c (``BodyLaw.level_state_at``), kept for the
-        last a of each body: the κ solve reads both bodies at one a, each needing the two."""
+    def _fixed_at(self, a):
+        """The terms of each body's response that move with a alone, by body law (None when the
+        finite-size ratio is a/ρ: they move with the partition then): ``BodyLaw.fixed_terms`` at
+        y = a/R, xc = a/ρ_c, and the pressure-profile factor 1/φ with its d/d ln a (``profile.py``,
+        None without it). Kept for the last a: a κ solve reads them at every iterate, the state at
+        its root once more."""
+        if self._ratio_rho:
+            return None
         a = np.asarray(a, dtype=float)
-        hit = self._levels_c.get(id(law))
+        hit = self._fixed
         if hit is not None and hit[0].shape == a.shape and np.array_equal(hit[0], a):
             return hit[1]
-        v = law.level_state_at(a * self._inv_rho_c[id(law)])
-        self._levels_c[id(law)] = (a.copy(), v)
-        return v
+        laws = [(law, s_.radius) for law, s_ in ((self.law1, self.s1), (self.law2, self.s2))
+                if law is not None]
+        level = {}  # the level weights at a/ρ_c: the profile factor reads both bodies'
+        if self._profile:
+            level = {id(law): law.level_state_at(a * self._inv_rho_c[id(law)]) for law, _ in laws}
+        out = {}
+        for law, R in laws:
+            terms = law.fixed_terms(a / R, self._z[id(law)], a * self._inv_rho_c[id(law)], level.get(id(law)))
+            other = self._profile.get(id(law))
+            profile = None
+            if other is not None:
+                ln_q, dln_q = profile_factor(*level[id(law)], *level[id(other)])
+                profile = (np.exp(ln_q), dln_q)
+            out[id(law)] = _BodyFixed(terms, profile)
+        self._fixed = (a.copy(), out)
+        return out
 
-    def _g(self, a, u, C=0.0, uA=0.0):
+    def _g(self, a, u, C=0.0, uA=0.0, fixed=None):
         """g = ln p_1 − ln p_2 + C (u − u_A) at (a, u), its u-derivative, and both responses
         (C, u_A: :meth:`_coupling` at a, constants of the κ solve; the pressures alone,
-        ``BodyLaw.response`` with ``pressure_only``)."""
+        ``BodyLaw.response`` with ``pressure_only``; ``fixed``: :meth:`_fixed_at` at a if at hand)."""
         w1, w2 = _sigmoid(u)
-        r1 = self._body(self.law1, a, w1 / self.R_star, self.s1.radius, True)
-        r2 = self._body(self.law2, a, w2 / self.R_star, self.s2.radius, True)
+        f1, f2 = (None, None) if fixed is None else (fixed[id(self.law1)], fixed[id(self.law2)])
+        r1 = self._body(self.law1, a, w1 / self.R_star, self.s1.radius, True, f1)
+        r2 = self._body(self.law2, a, w2 / self.R_star, self.s2.radius, True, f2)
         A1 = r1.dlnp_dlnx + (r1.dlnp_dlny if self._ratio_rho else 0.0)
         A2 = r2.dlnp_dlnx + (r2.dlnp_dlny if self._ratio_rho else 0.0)
         g = np.log(r1.p_m) - np.log(r2.p_m) + C * (u - uA)
@@ -319,9 +355,13 @@ class UnifiedPair:
         a = np.asarray(a, dtype=float)
         u0 = np.full(a.shape, self._u0) if u_guess is None else np.asarray(u_guess, dtype=float)
         C, _, uA, _ = (np.broadcast_to(v, a.shape) for v in self._coupling(a))  # fixed during the solve
+        fixed = self._fixed_at(a)  # so are the bodies' terms that move with a alone
 
         def f(u, idx):
-            g, dg, _, _ = self._g(a[idx], u, C[idx], uA[idx])
+            at = fixed
+            if fixed is not None and idx.size < a.size:
+                at = {k: v.take(idx) for k, v in fixed.items()}
+            g, dg, _, _ = self._g(a[idx], u, C[idx], uA[idx], at)
             return g, dg
 
         def describe(idx):
