@@ -340,7 +340,7 @@ class ContactLaw:
             None if u is None else u[j], None if u is None else u[j + 1])
         found = []
         for _ in range(_KINKS_PER_STEP):
-            kink, p_kink, u_kink = self._first_changes(lo, hi, p_lo, u_lo, u_hi)
+            kink, p_kink, u_kink = self._first_changes(lo, hi, p_lo, p_hi, u_lo, u_hi)
             found.append(kink)
             more = p_kink != p_hi
             if not more.any():
@@ -367,13 +367,15 @@ class ContactLaw:
         U = np.concatenate([u_lo[:, None], up.reshape(pts.shape), u_hi[:, None]], axis=1)
         return X[r, k], X[r, k + 1], P[r, k], P[r, k + 1], U[r, k], U[r, k + 1]
 
-    def _first_changes(self, lo, hi, p_lo, u_lo, u_hi):
-        """The first piece change above ``lo`` in each bracket [lo, hi] whose lower end has the
-        piece ``p_lo``, to ``_KINK_TOL``: one vectorised κ solve per pass (and the pieces,
-        :meth:`_pieces`), warm-started by u interpolated between the ends of each bracket
+    def _first_changes(self, lo, hi, p_lo, p_hi, u_lo, u_hi):
+        """The first piece change above ``lo`` in each bracket [lo, hi] whose ends have the
+        pieces ``p_lo``, ``p_hi``, to ``_KINK_TOL``: one vectorised κ solve per pass (and the
+        pieces, :meth:`_pieces`), warm-started by u interpolated between the ends of each bracket
         (u = ln(ρ_2/ρ_1) of the pass before; the brackets are sections of the first pass,
         :meth:`_split_changes`, where this guess is closer than the grid's Hermite). Returns the point
-        just above each change, its piece and u there (None for scenes without a κ solve)."""
+        just above each change, its piece and u there (None for scenes without a κ solve): the
+        upper end of the last bracket, whose piece and u a pass has solved (the first pass, or the
+        one that moved it there)."""
         p_lo = p_lo[:, None]
         n = _sections(float(np.max(hi - lo)), lo.size)
         frac = np.arange(1, n) / n
@@ -387,12 +389,12 @@ class ContactLaw:
             below, above = np.maximum(first - 1, 0), np.minimum(first, frac.size - 1)
             keep_lo, keep_hi = first == 0, first == frac.size
             lo, hi = np.where(keep_lo, lo, pts[rows, below]), np.where(keep_hi, hi, pts[rows, above])
+            p_hi = np.where(keep_hi, p_hi, pieces.reshape(pts.shape)[rows, above])
             if u_lo is not None:
                 up = up.reshape(pts.shape)
                 u_lo = np.where(keep_lo, u_lo, up[rows, below])
                 u_hi = np.where(keep_hi, u_hi, up[rows, above])
-        p_hi, u_at = self._pieces(hi, u_hi)
-        return hi, p_hi, u_at
+        return hi, p_hi, u_hi
 
     def _u_of(self, st: UnifiedState):
         """u = ln(ρ_2/ρ_1) of solved states (None if the pair needs no κ solve)."""
