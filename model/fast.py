@@ -316,7 +316,7 @@ class ContactLaw:
         a = self.pair.R_star * np.exp(lnX)
         if self.pair.mode != "general":
             return self.pair.piece_at(a), None
-        u = self.pair.solve_u(a, u_guess)
+        u = self.pair.solve_u(a, u_guess, with_c2=False)
         return self.pair.piece_at(a, u), u
 
     def _find_kinks(self, grid: np.ndarray, st: UnifiedState) -> np.ndarray:

@@ -245,7 +245,7 @@ class UnifiedPair:
         # the partner whose pressure profile each body is loaded by (``profile.py``; a/R ratio only:
         # the factor depends on a alone, which the y slot of the slopes carries)
         self._profile = {}
-        self._fixed = None  # (a, terms) of the last :meth:`_fixed_at`
+        self._fixed = None  # (a, with_c2, terms) of the last :meth:`_fixed_at`
         if self.mode == "general" and self.coeffs.pressure_profile == "flattened" and not self._ratio_rho:
             self._profile = {id(self.law1): self.law2, id(self.law2): self.law1}
 
@@ -256,7 +256,7 @@ class UnifiedPair:
         x = a * k
         y = x if self._ratio_rho else a / R
         if fixed is None:
-            fixed = self._fixed_at(a)
+            fixed = self._fixed_at(a, not pressure_only)
             fixed = None if fixed is None else fixed[id(law)]
         terms, profile = (None, None) if fixed is None else fixed
         r = law.response(x, y, self._z[id(law)], a * self._inv_rho_c[id(law)], pressure_only, fixed=terms)
@@ -265,18 +265,19 @@ class UnifiedPair:
         q, dln_q = profile
         return r._replace(p_m=r.p_m * q, dlnp_dlny=r.dlnp_dlny + dln_q)
 
-    def _fixed_at(self, a):
+    def _fixed_at(self, a, with_c2: bool = True):
         """The terms of each body's response that move with a alone, by body law (None when the
         finite-size ratio is a/ρ: they move with the partition then): ``BodyLaw.fixed_terms`` at
-        y = a/R, xc = a/ρ_c, and the pressure-profile factor 1/φ with its d/d ln a (``profile.py``,
-        None without it). Kept for the last a: a κ solve reads them at every iterate, the state at
-        its root once more."""
+        y = a/R, xc = a/ρ_c (those of c² only ``with_c2``), and the pressure-profile factor 1/φ
+        with its d/d ln a (``profile.py``, None without it). Kept for the last a: a κ solve reads
+        them at every iterate, the state at its root once more."""
         if self._ratio_rho:
             return None
         a = np.asarray(a, dtype=float)
         hit = self._fixed
-        if hit is not None and hit[0].shape == a.shape and np.array_equal(hit[0], a):
-            return hit[1]
+        if hit is not None and (hit[1] or not with_c2) and hit[0].shape == a.shape \
+                and np.array_equal(hit[0], a):
+            return hit[2]
         laws = [(law, s_.radius) for law, s_ in ((self.law1, self.s1), (self.law2, self.s2))
                 if law is not None]
         level = {}  # the level weights at a/ρ_c: the profile factor reads both bodies'
@@ -284,14 +285,15 @@ class UnifiedPair:
             level = {id(law): law.level_state_at(a * self._inv_rho_c[id(law)]) for law, _ in laws}
         out = {}
         for law, R in laws:
-            terms = law.fixed_terms(a / R, self._z[id(law)], a * self._inv_rho_c[id(law)], level.get(id(law)))
+            terms = law.fixed_terms(a / R, self._z[id(law)], a * self._inv_rho_c[id(law)], level.get(id(law)),
+                                    with_c2)
             other = self._profile.get(id(law))
             profile = None
             if other is not None:
                 ln_q, dln_q = profile_factor(*level[id(law)], *level[id(other)])
                 profile = (np.exp(ln_q), dln_q)
             out[id(law)] = _BodyFixed(terms, profile)
-        self._fixed = (a.copy(), out)
+        self._fixed = (a.copy(), with_c2, out)
         return out
 
     def _g(self, a, u, C=0.0, uA=0.0, fixed=None):
@@ -350,12 +352,14 @@ class UnifiedPair:
         """Both spheres (radius, material), for error messages."""
         return f"{_sphere_text(1, self.s1)}; {_sphere_text(2, self.s2)}"
 
-    def solve_u(self, a, u_guess=None) -> np.ndarray:
-        """κ solve: u = ln(ρ_2/ρ_1) with equal mean pressures, for each a (1-D)."""
+    def solve_u(self, a, u_guess=None, with_c2: bool = True) -> np.ndarray:
+        """κ solve: u = ln(ρ_2/ρ_1) with equal mean pressures, for each a (1-D). ``with_c2`` False:
+        the bodies' terms fixed during the solve (:meth:`_fixed_at`) without those of c², which
+        only a state at the roots reads."""
         a = np.asarray(a, dtype=float)
         u0 = np.full(a.shape, self._u0) if u_guess is None else np.asarray(u_guess, dtype=float)
         C, _, uA, _ = (np.broadcast_to(v, a.shape) for v in self._coupling(a))  # fixed during the solve
-        fixed = self._fixed_at(a)  # so are the bodies' terms that move with a alone
+        fixed = self._fixed_at(a, with_c2)  # so are the bodies' terms that move with a alone
 
         def f(u, idx):
             at = fixed
