@@ -164,7 +164,10 @@ def levels_with_n_slopes(Lambda, coeffs: Coefficients, n, t=None, with_c2: bool 
     one, two = lev == 1, lev == 2
     u = 1.0 - t
     smooth = coeffs.level_II_smooth
-    base = t * t * u * u if smooth else t * u  # the factor of P(t) in s(t)
+    if smooth:  # the powers of t that both shapes read
+        tt, t2 = t * t, 2.0 * t
+        s0, ds0, P_ds = tt * (3.0 - t2), 6.0 * t * u, t2 * u * (1.0 - t2)
+    base = tt * u * u if smooth else t * u  # the factor of P(t) in s(t)
     H_I = coeffs.H_bar_I
     parts = [(H_I, coeffs.H_bar_III_prefactor, coeffs.H_bar_III_exp_poly, coeffs.H_bar_shape,
               coeffs.H_bar_shape_n, True)]
@@ -175,26 +178,27 @@ def levels_with_n_slopes(Lambda, coeffs: Coefficients, n, t=None, with_c2: bool 
     for q_I, prefactor, exp_poly, b, bn, is_H in parts:
         lnq3, g = exp_poly_log_and_slope(exp_poly, n)
         q3 = prefactor * np.exp(lnq3)
+        dq3 = q3 - q_I
         P, dP = _poly_and_derivative(t, tuple(b)) if b else (0.0, 0.0)
         Pn = dPn = 0.0
         if bn:
             Pn, dPn = _poly_and_derivative(t, tuple(bn))
             P, dP = P + n * Pn, dP + n * dPn
         if smooth:
-            m0 = H_I * L / (q3 - H_I) if is_H else 0.0
-            dm0 = -m0 * q3 * g / (q3 - H_I) if is_H else 0.0
-            sv = t * t * (3.0 - 2.0 * t) + m0 * t * u * u + base * P
-            ds = 6.0 * t * u + m0 * u * (1.0 - 3.0 * t) + 2.0 * t * u * (1.0 - 2.0 * t) * P + base * dP
+            m0 = H_I * L / dq3 if is_H else 0.0
+            dm0 = -m0 * q3 * g / dq3 if is_H else 0.0
+            sv = s0 + m0 * t * u * u + base * P
+            ds = ds0 + m0 * u * (1.0 - 3.0 * t) + P_ds * P + base * dP
             s_n = dm0 * t * u * u + base * Pn
         else:
             sv = t + base * P
             ds = 1.0 + (1.0 - 2.0 * t) * P + base * dP
             s_n = base * Pn
-        q2 = q_I + (q3 - q_I) * sv
+        q2 = q_I + dq3 * sv
         with np.errstate(divide="ignore", invalid="ignore"):
             q = np.where(one, _HERTZ * Lam if is_H else C2_HERTZ, np.where(two, q2, q3))
-            sq = np.where(one, 1.0 if is_H else 0.0, np.where(two, (q3 - q_I) * ds / (L * q2), 0.0))
-            qn = np.where(one, 0.0, np.where(two, (q3 * g * sv + (q3 - q_I) * s_n) / q2, g))
+            sq = np.where(one, 1.0 if is_H else 0.0, np.where(two, dq3 * ds / (L * q2), 0.0))
+            qn = np.where(one, 0.0, np.where(two, (q3 * g * sv + dq3 * s_n) / q2, g))
         out += [q, sq, qn]
     if not with_c2:
         out += [None, None, None]

@@ -66,41 +66,44 @@ def solve_increasing(
     for it in range(maxiter):
         if idx.size == 0:
             return x
-        _check_defined(fx, x[idx], idx, n, describe)
         xi = x[idx]
+        _check_defined(fx, xi, idx, n, describe)
         done = fx == 0.0
         pos = fx > 0.0
         neg = ~pos & ~done
-        hi[idx] = np.where(pos, xi, hi[idx])
-        lo[idx] = np.where(neg, xi, lo[idx])
+        l = np.where(neg, xi, lo[idx])
+        h = np.where(pos, xi, hi[idx])
+        lo[idx], hi[idx] = l, h
         s_old = side[idx]
-        f_lo[idx] = np.where(neg, fx, np.where(pos & (s_old == 1), 0.5 * f_lo[idx], f_lo[idx]))
-        f_hi[idx] = np.where(pos, fx, np.where(neg & (s_old == -1), 0.5 * f_hi[idx], f_hi[idx]))
+        fl, fh = f_lo[idx], f_hi[idx]
+        fl = np.where(neg, fx, np.where(pos & (s_old == 1), 0.5 * fl, fl))
+        fh = np.where(pos, fx, np.where(neg & (s_old == -1), 0.5 * fh, fh))
+        f_lo[idx], f_hi[idx] = fl, fh
         side[idx] = np.where(pos, 1, np.where(neg, -1, s_old))
-        l, h = lo[idx], hi[idx]
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             newton = xi - fx / dx
-        ok = np.isfinite(newton) & (dx > 0.0) & (newton > l) & (newton < h)
-        ok &= np.abs(newton - xi) <= np.where(np.isfinite(l) & np.isfinite(h), np.inf, max_step)
+        expand_down, expand_up = ~np.isfinite(l), ~np.isfinite(h)
+        bracketed = ~(expand_down | expand_up)
+        usable = np.isfinite(newton) & (dx > 0.0)
+        step_n = np.abs(newton - xi)  # the Newton step's length
+        small = tol * np.maximum(1.0, np.abs(xi))  # convergence threshold
+        ok = usable & (newton > l) & (newton < h)
+        ok &= step_n <= np.where(bracketed, np.inf, max_step)
         if it % 8 == 7:  # guard against slow Newton progress near kinks
-            ok &= ~(np.isfinite(l) & np.isfinite(h))
+            ok &= ~bracketed
         # a Newton step below tol converges even where rounding puts it on a bracket end
-        ok |= np.isfinite(newton) & (dx > 0.0) & (np.abs(newton - xi) <= tol * np.maximum(1.0, np.abs(xi)))
+        ok |= usable & (step_n <= small)
         w = width[idx]
         # expansion towards the root: the doubling width, or the rejected Newton step up to max_step
         with np.errstate(invalid="ignore"):
-            reach = np.maximum(w, np.where(np.isfinite(newton) & (dx > 0.0),
-                                           np.minimum(np.abs(newton - xi), max_step), 0.0))
-        expand_down = ~np.isfinite(l)
-        expand_up = ~np.isfinite(h)
+            reach = np.maximum(w, np.where(usable, np.minimum(step_n, max_step), 0.0))
         with np.errstate(invalid="ignore", divide="ignore"):
-            fl, fh = f_lo[idx], f_hi[idx]
             regula = l - fl * (h - l) / (fh - fl)
             inside = np.isfinite(regula) & (regula > l) & (regula < h)
             closing = np.where(inside, regula, 0.5 * (l + h))
         xn = np.where(ok, newton, np.where(expand_down, xi - reach, np.where(expand_up, xi + reach, closing)))
-        width[idx] = np.where(~ok & (expand_down | expand_up), 2.0 * w, w)
-        conv = done | (np.abs(xn - xi) <= tol * np.maximum(1.0, np.abs(xi)))
+        width[idx] = np.where(~ok & ~bracketed, 2.0 * w, w)
+        conv = done | (np.abs(xn - xi) <= small)
         x[idx] = np.where(done, xi, xn)
         keep = ~conv
         idx = idx[keep]
