@@ -408,9 +408,11 @@ def exp_poly_log_and_slope(exp_poly, n):
     """Σ c_k n^(k+1) and its n-derivative Σ (k+1) c_k n^k (vectorised in n): the exponent of
     :func:`_exp_poly` and its slope, for the exponent read along the curve."""
     n = np.asarray(n, dtype=float)
-    s = np.zeros_like(n)
-    d = np.zeros_like(n)
-    for k in range(len(exp_poly) - 1, -1, -1):
+    if not exp_poly:
+        return np.zeros_like(n), np.zeros_like(n)
+    k = len(exp_poly) - 1
+    s, d = exp_poly[k] * n, np.full_like(n, (k + 1) * exp_poly[k])  # the first Horner step (n finite)
+    for k in range(len(exp_poly) - 2, -1, -1):
         s = (s + exp_poly[k]) * n
         d = d * n + (k + 1) * exp_poly[k]
     return s, d

@@ -82,10 +82,12 @@ def level(Lambda, coeffs: Coefficients) -> np.ndarray:
 
 
 def _poly_and_derivative(t, b: tuple[float, ...]):
-    """P(t) = Σ b_k t^k and P'(t)."""
-    P = np.full_like(t, b[-1])  # the first Horner step from P = dP = 0
-    dP = np.zeros_like(t)
-    for c in reversed(b[:-1]):
+    """P(t) = Σ b_k t^k and P'(t) (t finite)."""
+    if len(b) == 1:
+        return np.full_like(t, b[0]), np.zeros_like(t)
+    P = b[-1] * t + b[-2]  # the first two Horner steps from P = dP = 0
+    dP = np.full_like(t, b[-1])
+    for c in reversed(b[:-2]):
         dP = dP * t + P
         P = P * t + c
     return P, dP
@@ -363,7 +365,8 @@ def _limit_at(limit, coeffs: Coefficients, n: float, z: float):
 def _weight(z):
     """w = e^z/(1 + e^z) and ln(1 + e^z), without overflow."""
     e = np.exp(-np.abs(z))  # e^(−z) for z > 0, e^z otherwise
-    return np.where(z > 0.0, 1.0 / (1.0 + e), e / (1.0 + e)), np.maximum(z, 0.0) + np.log1p(e)
+    d = 1.0 + e
+    return np.where(z > 0.0, 1.0 / d, e / d), np.maximum(z, 0.0) + np.log1p(e)
 
 
 def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
@@ -385,9 +388,10 @@ def blend_from_logs(H_hs, c2_hs, lnHc, lncc, k: float, k_c: float | None = None,
 def blend_pressure(H_hs, lnHc, k: float):
     """The H̄ half of :func:`blend_from_logs`: H̄, w and ln r = ln H_hs − ln H̄_c."""
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
-        lnr = np.where(H_hs > 0.0, np.log(H_hs) - lnHc, -np.inf)
+        pos = H_hs > 0.0
+        lnr = np.where(pos, np.log(H_hs) - lnHc, -np.inf)
         w, log1p = _weight(k * lnr)
-        return np.where(H_hs > 0.0, H_hs * np.exp(-log1p / k), H_hs), w, lnr
+        return np.where(pos, H_hs * np.exp(-log1p / k), H_hs), w, lnr
 
 
 def collapse_pressure(H_hs, x, coeffs: Coefficients, n: float, z: float):
@@ -522,8 +526,9 @@ def finite_size_blend(terms: tuple[np.ndarray, ...], s, ds):
         f, dx = terms
         return f, dx, np.zeros_like(f)
     fe, de, fp, dp = terms
-    f = (1.0 - s) * fe + s * fp
-    return f, ((1.0 - s) * fe * de + s * fp * dp) / f, (fp - fe) * ds / f
+    f_e, f_p = (1.0 - s) * fe, s * fp  # the two shares of f
+    f = f_e + f_p
+    return f, (f_e * de + f_p * dp) / f, (fp - fe) * ds / f
 
 
 def _factors(Lambda, x, coeffs: Coefficients):

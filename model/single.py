@@ -112,7 +112,8 @@ def representative_strain(x, beta: float, growth: float = 0.0):
     ``beta_growth``)."""
     x = np.asarray(x, dtype=float)
     gx = growth * x
-    return beta * x * (1.0 + gx), (1.0 + 2.0 * gx) / (1.0 + gx)
+    g1 = 1.0 + gx
+    return beta * x * g1, (1.0 + 2.0 * gx) / g1
 
 
 #: three-point Gauss–Hermite rule of a standard normal variable t: nodes t_j, weights w_j
