@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -107,14 +108,29 @@ def _hermite_at(x, xs, ys, dys):
     return c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3]))
 
 
-def _take(st: UnifiedState, sel) -> UnifiedState:
-    """The states ``sel`` (slice or indices) of a batch of states."""
-    return UnifiedState(*(f[sel] for f in st))
+def _take(st, sel):
+    """The states ``sel`` (slice or indices) of a batch of states (:class:`UnifiedState` or
+    :class:`_Peaks`)."""
+    return type(st)(*(f[sel] for f in st))
 
 
-def _join(a: UnifiedState, b: UnifiedState) -> UnifiedState:
+def _join(a, b):
     """The batches of states a and b, one after the other."""
-    return UnifiedState(*(np.concatenate([x, y]) for x, y in zip(a, b, strict=True)))
+    return type(a)(*(np.concatenate([x, y]) for x, y in zip(a, b, strict=True)))
+
+
+class _Peaks(NamedTuple):
+    """The unloading branch of a peak at each of a batch of solved states (``unloading.py``)."""
+
+    recovery: np.ndarray  # δ_e/h_max
+    m: np.ndarray         # exponent of F = F_max ξ^m
+    h1_res: np.ndarray    # body 1's residual approach over h_max
+
+
+def _peaks_at(p: UnifiedPair, st: UnifiedState) -> _Peaks:
+    """:class:`_Peaks` of peaks at the states ``st`` of the pair p (``unloading.peak_parameters``)."""
+    pk = peak_parameters(p, st)
+    return _Peaks(pk.delta_e / st.h, pk.m, pk.h1_res / st.h)
 
 
 def _sections(width: float, kinks: int) -> int:
@@ -424,6 +440,9 @@ class ContactLaw:
             slopes[side][:, k] = _log_slopes(_take(batch, slice(m + side * nk, m + (side + 1) * nk)))
         self._lnX_nodes, self._node_state, self._slopes = lnX, st, slopes
         self._probe_state = _take(batch, slice(m + 2 * nk, None))
+        # the unloading branches of peaks at the nodes and probes, kept with their states
+        self._node_peaks = _peaks_at(self.pair, st)
+        self._probe_peaks = _peaks_at(self.pair, self._probe_state)
         self._assemble()
 
     def _refine(self, bad: np.ndarray) -> None:
@@ -440,6 +459,7 @@ class ContactLaw:
         order = np.argsort(np.concatenate([X, mid]), kind="stable")
         self._lnX_nodes = np.concatenate([X, mid])[order]
         self._node_state = _take(_join(self._node_state, st_mid), order)
+        self._node_peaks = _take(_join(self._node_peaks, _peaks_at(self.pair, st_mid)), order)
         new = np.array(_log_slopes(st_mid))  # midpoints lie inside smooth pieces: one slope
         self._slopes = np.concatenate([self._slopes, np.stack([new, new])], axis=2)[:, :, order]
         # probes, interval by interval: the rows of the kept intervals and those of the halves,
@@ -448,8 +468,9 @@ class ContactLaw:
         rows = np.concatenate([np.arange(n_old).reshape(-1, P)[~bad],
                                n_old + np.arange(left.size * P).reshape(-1, P)])
         rows = rows[np.argsort(np.concatenate([X[:-1][~bad], left]), kind="stable")]
-        probes = _join(self._probe_state, _take(batch, slice(mid.size, None)))
-        self._probe_state = _take(probes, rows.ravel())
+        st_new = _take(batch, slice(mid.size, None))
+        self._probe_state = _take(_join(self._probe_state, st_new), rows.ravel())
+        self._probe_peaks = _take(_join(self._probe_peaks, _peaks_at(self.pair, st_new)), rows.ravel())
         self._assemble()
 
     def _assemble(self) -> None:
@@ -480,9 +501,8 @@ class ContactLaw:
         # unloading branch of a peak at each node (``unloading.py``), interpolated linearly in s:
         # recovery δ_e/h_max (1: an elastic peak, which unloads along the loading curve), the
         # exponent m and body 1's residual approach over h_max
-        pk = peak_parameters(self.pair, st)
-        self.unloading_table = {"ln_h": s, "recovery": pk.delta_e / st.h, "m": pk.m,
-                                "h1_res": pk.h1_res / st.h}
+        pk = self._node_peaks
+        self.unloading_table = {"ln_h": s, "recovery": pk.recovery, "m": pk.m, "h1_res": pk.h1_res}
         tab = self.unloading_table  # per interval: value at its start and increment over it
         self._un = {k: (tab[k][:-1].copy(), np.diff(tab[k])) for k in ("recovery", "m", "h1_res")}
         # peaks up to the last node of the elastic prefix (recovery 1: Level I) unload along the
@@ -514,7 +534,7 @@ class ContactLaw:
         eF, ea, ek = (_SAFETY * np.abs(x / y - 1.0) for x, y in ((F, st.F), (a, st.a), (k, st.stiffness)))
         n = self._lnX_nodes.size - 1  # probes are ordered interval by interval
         bad = (np.maximum(np.maximum(eF, ea), ek) > self.rtol).reshape(n, len(_PROBES)).any(axis=1)
-        eU = self._unloading_error(st)
+        eU = self._unloading_error(st, self._probe_peaks)
         bad |= (eU > UNLOADING_RTOL).reshape(n, len(_PROBES)).any(axis=1)
         return {
             "F": float(np.max(eF)),
@@ -524,20 +544,18 @@ class ContactLaw:
             "unloading_F": float(np.max(eU)),
         }, bad
 
-    def _unloading_error(self, st: UnifiedState) -> np.ndarray:
+    def _unloading_error(self, st: UnifiedState, pk: _Peaks) -> np.ndarray:
         """Bound on the unloading branch's F error (relative to F_max) of the linear recovery and
-        exponent at exact states ``st``: |Δδ_e|/δ_e + |Δm|/(e m) (F = F_max ξ^m: a relative
-        error ε of δ_e moves F by at most ~ε F_max, an error Δm by at most Δm/(e m) F_max), × the
-        safety factor."""
-        pk = peak_parameters(self.pair, st)
+        exponent at exact states ``st`` (their peaks' exact branches ``pk``): |Δδ_e|/δ_e
+        + |Δm|/(e m) (F = F_max ξ^m: a relative error ε of δ_e moves F by at most ~ε F_max, an
+        error Δm by at most Δm/(e m) F_max), × the safety factor."""
         s = np.log(st.h)
         j = self._index(s)
         t = (s - self._s[j]) * self._inv_ds[j]
         r0, dr = self._un["recovery"]
         m0, dm = self._un["m"]
         rec, m = r0[j] + t * dr[j], m0[j] + t * dm[j]
-        exact = pk.delta_e / st.h
-        return _SAFETY * (np.abs(rec / exact - 1.0) + np.abs(m - pk.m) / (math.e * pk.m))
+        return _SAFETY * (np.abs(rec / pk.recovery - 1.0) + np.abs(m - pk.m) / (math.e * pk.m))
 
     # ------------------------------------------------------------------ calibrated range
     def _range_thresholds(self) -> None:
