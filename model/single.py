@@ -309,9 +309,10 @@ class FixedTerms(NamedTuple):
     collapse_H: tuple | None   # y-terms of the collapse limit H̄_c (``CollapseLimitAtZ.x_terms``)
     collapse_c2: tuple | None
 
-    def take(self, idx) -> FixedTerms:
-        """The terms at the points ``idx``."""
-        return FixedTerms(*(None if f is None else tuple(v[idx] for v in f) for f in self))
+    def take(self, idx, with_c2: bool = True) -> FixedTerms:
+        """The terms at the points ``idx`` (without those of c² unless ``with_c2``)."""
+        return FixedTerms(*(None if f is None or (name.endswith("c2") and not with_c2) else
+                            tuple(v[idx] for v in f) for name, f in zip(self._fields, self, strict=True)))
 
 
 @dataclass(frozen=True)

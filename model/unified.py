@@ -142,9 +142,9 @@ class _BodyFixed(NamedTuple):
     terms: FixedTerms
     profile: tuple | None  # pressure-profile factor 1/φ and d ln(1/φ)/d ln a
 
-    def take(self, idx) -> _BodyFixed:
-        """The terms at the points ``idx``."""
-        return _BodyFixed(self.terms.take(idx), None if self.profile is None else
+    def take(self, idx, with_c2: bool = True) -> _BodyFixed:
+        """The terms at the points ``idx`` (without those of c² unless ``with_c2``)."""
+        return _BodyFixed(self.terms.take(idx, with_c2), None if self.profile is None else
                           tuple(v[idx] for v in self.profile))
 
 
@@ -364,7 +364,7 @@ class UnifiedPair:
         def f(u, idx):
             at = fixed
             if fixed is not None and idx.size < a.size:
-                at = {k: v.take(idx) for k, v in fixed.items()}
+                at = {k: v.take(idx, with_c2=False) for k, v in fixed.items()}  # pressures alone
             g, dg, _, _ = self._g(a[idx], u, C[idx], uA[idx], at)
             return g, dg
 
