@@ -102,7 +102,8 @@ class SymmetricSolver:
     ``"ldl"`` (qdldl, SuperLU fallback) or ``"superlu"`` (SuperLU only); a method whose package
     is missing falls back to the next. ``stats``: counts of ``cholesky_fresh`` (analysis and
     factorisation) and ``cholesky_update`` (numeric factorisation on the stored analysis), of
-    them ``not_definite`` (refused: LDLᵀ took over), ``ldl_fresh``
+    them ``not_definite`` (refused: LDLᵀ took over, or the definite substitute of
+    :meth:`solve_upper`, counted in ``substitute``), ``ldl_fresh``
     (ordering + factorisation), ``ldl_update`` (numeric refactorisation on the stored analysis)
     and ``fallback`` (SuperLU used because LDLᵀ failed or was inaccurate).
     """
@@ -121,8 +122,8 @@ class SymmetricSolver:
         self._keys, self._rows, self._indptr, self._n = None, None, None, 0
         self._last = None  # (indptr, indices, positions in the stored pattern) of the last matrix
         self._cholesky, self._cholesky_key = None, None  # SupernodalCholesky and its pattern's key
-        self.stats = {"cholesky_fresh": 0, "cholesky_update": 0, "not_definite": 0, "ldl_fresh": 0,
-                      "ldl_update": 0, "fallback": 0, "superlu": 0}
+        self.stats = {"cholesky_fresh": 0, "cholesky_update": 0, "not_definite": 0, "substitute": 0,
+                      "ldl_fresh": 0, "ldl_update": 0, "fallback": 0, "superlu": 0}
         self.times = {"factorisation": 0.0, "solve": 0.0}
         self._reuse = None  # solve() of the factors that gave the last accepted solution
 
@@ -189,11 +190,19 @@ class SymmetricSolver:
         """Upper-triangular CSC matrix of the stored pattern holding ``data``."""
         return sp.csc_matrix((data, self._rows, self._indptr), shape=(self._n, self._n))
 
-    def solve_upper(self, U: sp.csc_matrix, diag: np.ndarray, b: np.ndarray, key: object) -> np.ndarray:
+    def solve_upper(self, U: sp.csc_matrix, diag: np.ndarray, b: np.ndarray, key: object,
+                    definite=None) -> np.ndarray:
         """x with K x = b, K given by its upper triangle ``U`` (sorted CSC) and its diagonal
         ``diag``; ``key`` names U's pattern (a :class:`ConstrainedPattern`: the same key, the
         same pattern). The symbolic analysis is made once per key, so no conversion, triangle
-        extraction or pattern comparison is paid per solve."""
+        extraction or pattern comparison is paid per solve.
+
+        ``definite``: None, or ``() -> (U', diag')`` on the same pattern, a positive definite
+        approximation of K: where Cholesky refuses K, it factors K' instead (counted in
+        ``substitute``) and x solves K' x = b, a quasi-Newton step, rather than taking K's
+        LDLᵀ."""
+        system = [U, diag]  # the matrix factored: K, or K' after a refusal
+
         def factor():
             if self.method == "cholesky":
                 fresh = self._cholesky_key is not key
@@ -203,8 +212,16 @@ class SymmetricSolver:
                 try:
                     self._cholesky.factor(U)
                     return self._cholesky
-                except ArithmeticError:  # not positive definite: LDLᵀ, then SuperLU if need be
+                except ArithmeticError:  # not positive definite: K', else LDLᵀ, then SuperLU
                     self.stats["not_definite"] += 1
+                if definite is not None:
+                    system[:] = definite()
+                    try:
+                        self._cholesky.factor(system[0])
+                        self.stats["substitute"] += 1
+                        return self._cholesky
+                    except ArithmeticError:
+                        system[:] = [U, diag]
             if self._solver is not None and self._pattern is key:
                 self._solver.update(U, upper=True)
                 self.stats["ldl_update"] += 1
@@ -213,8 +230,8 @@ class SymmetricSolver:
                 self._pattern, self._keys = key, None
                 self.stats["ldl_fresh"] += 1
             return self._solver
-        return self._checked(b, factor, lambda x: U @ x + U.T @ x - diag * x,
-                             lambda: U + sp.triu(U, k=1).T)
+        return self._checked(b, factor, lambda x: system[0] @ x + system[0].T @ x - system[1] * x,
+                             lambda: system[0] + sp.triu(system[0], k=1).T)
 
     def solve(self, K: sp.spmatrix, b: np.ndarray) -> np.ndarray:
         """x with K x = b; LDLᵀ where it is accurate, SuperLU otherwise."""

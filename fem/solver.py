@@ -334,6 +334,33 @@ def stalled(res) -> bool:
     return max(res[-2:]) <= STALL_BELOW and min(res[-2:]) >= 0.1 * min(res[-4:-2])
 
 
+def bracketed_line_search(slope, s0: float, max_steps: int = 4):
+    """(α, payload) of an energy line search along a Newton step of slope s0 = s(0) < 0, where
+    ``slope(α)`` → (s(α), payload) is the potential's slope at u + α du (Crisfield 1991, §9.3).
+
+    α = 1 is taken when |s(1)| ≤ ½|s0| or s(1) < 0 (the zero lies beyond the step). Otherwise
+    the zero of s is bracketed by [lo, hi], s(lo) < 0 < s(hi), and α moves to the secant zero
+    within it, but not below the bracket's middle, until |s(α)| ≤ ½|s0|. A node that starts to
+    penetrate a penalty contact within the step bends s up at once past its entry: the secant's
+    zero then lies near lo, and accepting the first descending α (the rule of the one-body
+    search) took 0.1 of the step per Newton iteration on the two-body penalty pair (E/σY 200 and
+    600, R₂ = 2R₁, to h = 0.03 R₁: 120 increments with 6 rejected, against 103 with 4 here).
+    Returns the accepted α, else the last descending α tried, else the last α tried.
+    """
+    alpha, lo, s_lo, hi, s_hi, below = 1.0, 0.0, s0, None, None, None
+    for _ in range(max_steps):
+        s_a, payload = slope(alpha)
+        tried = (alpha, payload)
+        if abs(s_a) <= 0.5 * abs(s0) or (s_a < 0.0 and hi is None):
+            return tried
+        if s_a < 0.0:
+            lo, s_lo, below = alpha, s_a, tried
+        else:
+            hi, s_hi = alpha, s_a
+        alpha = float(np.clip(lo + (hi - lo) * s_lo / (s_lo - s_hi), lo + 0.5 * (hi - lo), hi))
+    return below or tried
+
+
 def freeze_toggling(log: dict, plastic: np.ndarray, elastic: np.ndarray | None) -> np.ndarray | None:
     """The points Newton keeps elastic for the rest of the increment (``elastic`` grown).
 

@@ -47,6 +47,7 @@ from .solver import (
     RunResult,
     SolverOptions,
     _RunState,
+    bracketed_line_search,
     check_unload_at,
     cycles_as_arrays,
     finish_curves,
@@ -256,14 +257,15 @@ class ContactPass:
         return pen, lam, self._force(dofs, kin.grad[:, rows] * signs, lam[rows])
 
     def penalty_blocks(self, kin: Kinematics, k_n: float, pen, lam):
-        """∂(Gᵀλ)/∂u per penetrating node as dense blocks: dofs (10, n) and values
-        (10, 10, n) = w k_N A ∂g ∂gᵀ − λ ∂²g (:meth:`penalty_tangent` without the sparse sums)."""
+        """∂(Gᵀλ)/∂u per penetrating node as dense blocks: dofs (10, n) and the values
+        (10, 10, n) of its two parts, w k_N A ∂g ∂gᵀ (positive semi-definite) and − λ ∂²g (the
+        master's curvature, of either sign) (:meth:`penalty_tangent` without the sparse sums)."""
         rows = np.flatnonzero(pen)
         dofs, signs = self._dofs_and_signs(kin.seg, rows)
         gl = kin.grad[:, rows] * signs
         H = gap_hessian(kin.coords[:, rows], self.side) * signs[:, None, :] * signs[None, :, :]
         kA = self.weight * k_n * self.area0[rows]
-        return dofs, kA * gl[:, None, :] * gl[None, :, :] - lam[rows] * H
+        return dofs, kA * gl[:, None, :] * gl[None, :, :], -lam[rows] * H
 
     def _reference_interval(self, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Reference radius of the candidates ``rows`` and the master interval under each of them
@@ -365,6 +367,10 @@ class TwoBodySolver(CycleLegs):
         #: symbolic analysis per contact zone; False: the growing pattern of SymmetricSolver.solve
         self.fixed_pattern = True
         self._pattern = None
+        #: penalty contact: where the tangent is not positive definite, solve with it less the
+        #: master-curvature part −λ ∂²g of the contact blocks (positive definite when the bodies'
+        #: tangent is) instead of its LDLᵀ (:meth:`SymmetricSolver.solve_upper`)
+        self.curvature_substitute = True
 
     # ------------------------------------------------------------------ bodies
     def _body_elastic(self, i: int):
@@ -475,7 +481,8 @@ class TwoBodySolver(CycleLegs):
                               f"(last relative residual {log['res'][-1]:.2e})")
 
     def _line_search(self, u, du, f0, kin0, states, contact_force, max_steps: int = 4):
-        """Energy line search on the Lagrangian with the new multipliers fixed (cf. solver.py);
+        """Energy line search on the Lagrangian with the new multipliers fixed
+        (:func:`~.solver.bracketed_line_search`);
         ``contact_force(u, kin)`` → (Gᵀλ, kinematics) (penalty: λ follows u).
 
         Returns the new u and, when the accepted step was evaluated, its per-body
@@ -510,14 +517,12 @@ class TwoBodySolver(CycleLegs):
         s0 = float(np.dot(duf, (f0 - contact_force(u, kin0)[0])[free]))
         if s0 >= 0.0:
             return u + du, None, None
-        alpha, lo, s_lo = 1.0, 0.0, s0
-        for _ in range(max_steps):
+
+        def at(alpha):
             trial = u + alpha * du
             s_a, known, kin = slope(trial, Fs if alpha == 1.0 else None)
-            if abs(s_a) <= 0.5 * abs(s0) or s_a < 0.0:
-                return trial, known, kin
-            alpha = float(np.clip(lo + (alpha - lo) * s_lo / (s_lo - s_a), 0.1 * alpha, alpha))
-        return trial, known, kin
+            return s_a, (trial, known, kin)
+        return bracketed_line_search(at, s0, max_steps)[1]
 
     def _exact_force(self, active, lam):
         """u, kinematics → (Gᵀλ, kinematics) with the active set and multipliers fixed."""
@@ -575,8 +580,9 @@ class TwoBodySolver(CycleLegs):
         blocks = [p.penalty_blocks(kin, self.k_penalty, pen, lam)
                   for p, kin, pen, lam in zip(self.passes, kins, pens, lams, strict=True)]
         keys = np.concatenate([(d[:, None, :].astype(np.int64) * n + d[None, :, :]).ravel()
-                               for d, _ in blocks])
-        vals = np.concatenate([v.ravel() for _, v in blocks])
+                               for d, _, _ in blocks])
+        normal = np.concatenate([v.ravel() for _, v, _ in blocks])
+        curvature = np.concatenate([v.ravel() for _, _, v in blocks])
         pat = self._pattern
         pos = None if pat is None else np.minimum(np.searchsorted(pat.keys, keys), pat.keys.size - 1)
         if pat is None or np.any(pat.keys[pos] != keys):
@@ -588,12 +594,15 @@ class TwoBodySolver(CycleLegs):
             pos = np.searchsorted(pat.keys, keys)
         data = np.zeros(pat.keys.size)
         data[pat.body] = K.data
-        np.add.at(data, pos, vals)  # a few thousand entries: no pass over the whole pattern
+        np.add.at(data, pos, normal)  # a few thousand entries: no pass over the whole pattern
+        definite = data.copy() if self.curvature_substitute else None
+        np.add.at(data, pos, curvature)
         scale = float(np.abs(data[pat.diag]).mean())
         rhs = -r
         rhs[self.fixed] = 0.0
         U, diag = pat.upper.upper(data, self.fixed, scale)
-        du[free] = self.linear.solve_upper(U, diag, rhs, pat.upper)[free]
+        substitute = None if definite is None else (lambda: pat.upper.upper(definite, self.fixed, scale))
+        du[free] = self.linear.solve_upper(U, diag, rhs, pat.upper, substitute)[free]
         self._tangent = sp.csr_matrix((data, pat.indices, pat.indptr), shape=(n, n))
         return du
 

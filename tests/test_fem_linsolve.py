@@ -10,8 +10,8 @@ from spherecontact.fem.linsolve import ConstrainedPattern, SupernodalCholesky, S
 from spherecontact.fem.solver import IndentationSolver, SolverOptions
 from spherecontact.model import Material
 
-NONE = {"cholesky_fresh": 0, "cholesky_update": 0, "not_definite": 0, "ldl_fresh": 0, "ldl_update": 0,
-        "fallback": 0, "superlu": 0}
+NONE = {"cholesky_fresh": 0, "cholesky_update": 0, "not_definite": 0, "substitute": 0, "ldl_fresh": 0,
+        "ldl_update": 0, "fallback": 0, "superlu": 0}
 
 
 def _laplacian(n: int, shift: float = 0.1) -> sp.csr_matrix:
@@ -147,6 +147,30 @@ def test_cholesky_reuses_its_analysis_keeps_explicit_zeros_and_gives_way_to_ldl(
     x = s.solve_upper(U, diag, b, pattern)
     assert np.abs(_full(U, diag) @ x - b).max() < 1e-9
     assert s.stats["not_definite"] == 1 and s.stats["ldl_fresh"] == 1 and s.stats["fallback"] == 0
+
+
+def test_a_refused_matrix_is_replaced_by_its_definite_substitute_when_one_is_given():
+    """solve_upper(..., definite): Cholesky refuses K and factors the substitute K' instead, so x
+    solves K' x = b (a quasi-Newton step), counted; a substitute that is not definite either
+    leaves K to LDLᵀ."""
+    K = _laplacian(8)
+    K.sort_indices()
+    n = K.shape[0]
+    pattern = ConstrainedPattern(K.indptr, K.indices)
+    fixed = np.array([0, 9, 30])
+    b = np.linspace(-1.0, 1.0, n)
+    shifted = K - 0.5 * sp.eye(n, format="csr")
+    shifted.sort_indices()
+    U, diag = pattern.upper(shifted.data, fixed, 1.0)
+    good = pattern.upper(K.data, fixed, 1.0)
+    s = SymmetricSolver("cholesky")
+    x = s.solve_upper(U, diag, b, pattern, lambda: good)
+    assert np.abs(_full(*good) @ x - b).max() < 1e-12
+    assert np.abs(_full(U, diag) @ x - b).max() > 0.1  # not K's solution
+    assert s.stats == {**NONE, "cholesky_fresh": 1, "not_definite": 1, "substitute": 1}
+    x = s.solve_upper(U, diag, b, pattern, lambda: pattern.upper(2.0 * shifted.data, fixed, 1.0))
+    assert np.abs(_full(U, diag) @ x - b).max() < 1e-9
+    assert s.stats["not_definite"] == 2 and s.stats["substitute"] == 1 and s.stats["ldl_fresh"] == 1
 
 
 def test_bad_method_is_named():

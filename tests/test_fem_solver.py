@@ -348,3 +348,42 @@ def test_a_failed_loading_step_caps_the_next_ones(monkeypatch):
     # the capped one stays at about STEP_SHRINK of it
     assert np.all(capped[1:] <= uncapped[1:])
     assert np.all(capped[2:] <= (STEP_SHRINK + 0.05) * uncapped[2:])
+
+
+def _kinked_slope(s0: float, entry: float, stiffness: float):
+    """s(α) of a step along which a penalty node enters contact at α = ``entry``: the linear slope
+    s0 (1 − α) of the Newton model, bent up by ``stiffness`` past the entry; the calls recorded."""
+    calls = []
+
+    def slope(alpha):
+        calls.append(alpha)
+        return s0 * (1.0 - alpha) + stiffness * max(alpha - entry, 0.0), alpha
+    return slope, calls
+
+
+@pytest.mark.parametrize("entry", [0.8, 0.3, 0.05])
+def test_line_search_brackets_the_zero_of_a_kinked_slope(entry):
+    """The zero of s past a node's entry is bracketed, not left at the first descending α: the
+    accepted α has |s| ≤ ½|s0| or lies just below the entry (2⁻⁷ of the step, in 8 trials), where
+    the secant alone gives 0.1 (entries 0.8, 0.3) or 0.01 (entry 0.05), which the one-body rule
+    accepts as descending."""
+    from spherecontact.fem.solver import bracketed_line_search
+    s0 = -1.0
+    slope, calls = _kinked_slope(s0, entry, 1e4)
+    alpha, payload = bracketed_line_search(slope, s0, max_steps=8)
+    s_a = slope(alpha)[0]
+    assert payload == alpha
+    assert abs(s_a) <= 0.5 * abs(s0) or (entry - 2**-7 <= alpha <= entry and s_a < 0.0)
+    assert alpha >= min(0.5, entry - 2**-7) and calls[0] == 1.0 and len(calls) <= 9
+
+
+def test_line_search_takes_the_full_step_or_the_best_descent_it_found():
+    """s(1) < 0: the full step at once; a search that runs out of steps returns the last
+    descending α tried, not the last α (whose slope is positive), and without any, the last α."""
+    from spherecontact.fem.solver import bracketed_line_search
+    slope, calls = _kinked_slope(-1.0, 2.0, 1e4)  # no entry within the step
+    assert bracketed_line_search(slope, -1.0)[0] == 1.0 and calls == [1.0]
+    slope, calls = _kinked_slope(-1.0, 0.3, 1e4)
+    assert bracketed_line_search(slope, -1.0, max_steps=3)[0] == 0.25 and calls == [1.0, 0.5, 0.25]
+    slope, calls = _kinked_slope(-1.0, 0.01, 1e6)
+    assert bracketed_line_search(slope, -1.0, max_steps=2)[0] == 0.5 and calls == [1.0, 0.5]
