@@ -80,6 +80,10 @@ ZONE_GROWTH = 1.25
 #: increment on that pair against 3.8, and at 1e-8 the run had not finished after 31 min where
 #: the exact tangent took 20
 PENALTY_PAIR_TOL = 1e-8
+#: trials of the two-body line search (:func:`~.solver.bracketed_line_search`): the bench pair
+#: (E₂ = 3E₁, R₂ = 2R₁, penalty 100, to h = 0.03 R₁) with 4 / 6 / 8 / 12: 103 / 82 / 78 / 78
+#: increments, 4 / 2 / 1 / 1 of them failed, 717 / 632 / 567 / 561 Newton iterations
+LINE_SEARCH_STEPS = 8
 
 
 def slave_index(material1: Material, radius1: float, material2: Material, radius2: float,
@@ -480,7 +484,7 @@ class TwoBodySolver(CycleLegs):
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {log['res'][-1]:.2e})")
 
-    def _line_search(self, u, du, f0, kin0, states, contact_force, max_steps: int = 4):
+    def _line_search(self, u, du, f0, kin0, states, contact_force, max_steps: int = LINE_SEARCH_STEPS):
         """Energy line search on the Lagrangian with the new multipliers fixed
         (:func:`~.solver.bracketed_line_search`);
         ``contact_force(u, kin)`` → (Gᵀλ, kinematics) (penalty: λ follows u).
