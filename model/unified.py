@@ -246,6 +246,7 @@ class UnifiedPair:
         # the factor depends on a alone, which the y slot of the slopes carries)
         self._profile = {}
         self._fixed = None  # (a, with_c2, terms) of the last :meth:`_fixed_at`
+        self._coupling_last = None  # (a, terms) of the last :meth:`_coupling`
         if self.mode == "general" and self.coeffs.pressure_profile == "flattened" and not self._ratio_rho:
             self._profile = {id(self.law1): self.law2, id(self.law2): self.law1}
 
@@ -312,9 +313,14 @@ class UnifiedPair:
     def _coupling(self, a):
         """C(a) = λ s_1 s_2 e^(−(ln(P_1/P_2)/δ)²) of the interface equation, the anchor
         u_A(a) = u_H/(1 + (a/(a_c R*))^k) and their derivatives in ln a (module docstring), from
-        both bodies at the Hertz partition x_i = a/ρ_i,H. λ = 0: (0, 0, 0, 0)."""
+        both bodies at the Hertz partition x_i = a/ρ_i,H. λ = 0: (0, 0, 0, 0). Kept for the last
+        a: a κ solve and the state at its root read them."""
         if not self._coupled:
             return 0.0, 0.0, 0.0, 0.0
+        a = np.asarray(a, dtype=float)
+        hit = self._coupling_last
+        if hit is not None and hit[0].shape == a.shape and np.array_equal(hit[0], a):
+            return hit[1]
         co = self.coeffs
         s1, d1, P1, m1 = self.law1.plastic_state_at(a / self._rho_hertz[0])
         s2, d2, P2, m2 = self.law2.plastic_state_at(a / self._rho_hertz[1])
@@ -328,7 +334,9 @@ class UnifiedPair:
         lam = co.interface_coupling * self._u0**2 / (self._u0**2 + _MODULUS_RATIO**2)  # E-driven only
         C = lam * s1 * s2 * e
         dC = lam * ((d1 * s2 + s1 * d2) * e + s1 * s2 * de)
-        return C, dC, self._u0 * (1.0 - phi), -self._u0 * co.interface_exponent * phi * (1.0 - phi)
+        out = C, dC, self._u0 * (1.0 - phi), -self._u0 * co.interface_exponent * phi * (1.0 - phi)
+        self._coupling_last = (a.copy(), out)
+        return out
 
     def _similar_somewhere(self) -> bool:
         """False when the similarity factor e^(−q²), q = ln(P_1/P_2)/δ, is below e^(−36) at every
