@@ -128,7 +128,8 @@ def test_two_body_penalty_pair_starts_each_increment_from_the_last_tangent(monke
 def test_two_body_penalty_tangent_keeps_one_pattern_per_zone():
     """The two-body penalty tangent on its fixed superset pattern: one symbolic analysis per
     contact zone (about a dozen per run, against one per new contact pair on the growing pattern),
-    numeric updates otherwise, and the growing pattern's answers to round-off."""
+    numeric updates otherwise, and the growing pattern's answers to round-off (both taking the
+    LDLᵀ of a tangent Cholesky refuses: the growing pattern has no definite substitute)."""
     from spherecontact.fem.twobody import TwoBodySolver
 
     runs = {}
@@ -136,6 +137,7 @@ def test_two_body_penalty_tangent_keeps_one_pattern_per_zone():
         solver = TwoBodySolver(PLASTIC, 1.0, Material(E=600.0, nu=0.3, sigma_y=1.0), 1.0, density=0.5,
                                options=SolverOptions(penalty=100.0))
         solver.fixed_pattern = fixed
+        solver.curvature_substitute = False
         runs[fixed] = (solver, solver.run(0.004))
     solver, res = runs[True]
     t, t_old = res.timings, runs[False][1].timings
@@ -148,3 +150,24 @@ def test_two_body_penalty_tangent_keeps_one_pattern_per_zone():
     for key in ("F", "a", "h1", "h2"):
         old = runs[False][1].curves[key]
         np.testing.assert_allclose(res.curves[key], old, rtol=0, atol=1e-9 * np.abs(old).max())
+
+
+def test_two_body_penalty_definite_substitute_changes_the_steps_not_the_answers():
+    """Where Cholesky refuses the pair's tangent, the tangent less its master-curvature part is
+    solved instead (``curvature_substitute``): the run uses it, and every increment converges to
+    the answers of the run that takes LDLᵀ of the full tangent there."""
+    from spherecontact.fem.twobody import TwoBodySolver
+
+    runs = {}
+    for substitute in (True, False):
+        solver = TwoBodySolver(PLASTIC, 1.0, Material(E=600.0, nu=0.3, sigma_y=1.0), 1.0, density=0.5,
+                               options=SolverOptions(penalty=100.0))
+        solver.curvature_substitute = substitute
+        runs[substitute] = solver.run(0.004)
+    new, old = runs[True], runs[False]
+    assert new.timings["linear_substitute"] > 0 and old.timings["linear_substitute"] == 0
+    assert old.timings["linear_ldl_update"] + old.timings["linear_ldl_fresh"] > 0
+    assert new.h.size == old.h.size
+    for key in ("F", "a", "h1", "h2"):
+        np.testing.assert_allclose(new.curves[key], old.curves[key], rtol=0,
+                                   atol=1e-8 * np.abs(old.curves[key]).max())
