@@ -47,6 +47,7 @@ from .solver import (
     RunResult,
     SolverOptions,
     _RunState,
+    admissible_step,
     bracketed_line_search,
     check_unload_at,
     cycles_as_arrays,
@@ -508,13 +509,7 @@ class TwoBodySolver(CycleLegs):
             Gt_lam, kin = contact_force(trial, None)
             return float(np.dot(duf, (f - Gt_lam)[free])), known, kin
 
-        beta = 1.0
-        Fs = self._deformation_gradients(u + du)
-        while not all(positive_jacobian(Fv) for Fv in Fs):
-            beta *= 0.5
-            if beta < 2**-6:
-                raise IncrementFailed("inverted element (J <= 0) even after step halving")
-            Fs = self._deformation_gradients(u + beta * du)
+        beta, Fs = admissible_step(u, du, self._deformation_gradients)[1:]
         du = beta * du
         if not self.options.line_search:
             return u + du, None, None
@@ -599,14 +594,20 @@ class TwoBodySolver(CycleLegs):
         data = np.zeros(pat.keys.size)
         data[pat.body] = K.data
         np.add.at(data, pos, normal)  # a few thousand entries: no pass over the whole pattern
-        definite = data.copy() if self.curvature_substitute else None
+        touched = np.unique(pos)
+        without_curvature = data[touched]  # the entries the curvature part changes, before it
         np.add.at(data, pos, curvature)
         scale = float(np.abs(data[pat.diag]).mean())
         rhs = -r
         rhs[self.fixed] = 0.0
         U, diag = pat.upper.upper(data, self.fixed, scale)
-        substitute = None if definite is None else (lambda: pat.upper.upper(definite, self.fixed, scale))
-        du[free] = self.linear.solve_upper(U, diag, rhs, pat.upper, substitute)[free]
+
+        def definite():  # the tangent less the curvature part, made only when Cholesky refuses
+            d = data.copy()
+            d[touched] = without_curvature
+            return pat.upper.upper(d, self.fixed, scale)
+        du[free] = self.linear.solve_upper(U, diag, rhs, pat.upper,
+                                           definite if self.curvature_substitute else None)[free]
         self._tangent = sp.csr_matrix((data, pat.indices, pat.indptr), shape=(n, n))
         return du
 

@@ -148,6 +148,11 @@ class _BodyFixed(NamedTuple):
                           tuple(v[idx] for v in self.profile))
 
 
+def _held_at(hit, a: np.ndarray) -> bool:
+    """True when ``hit``, a cache entry (a, ...) kept for the last contact radii, holds these a."""
+    return hit is not None and hit[0].shape == a.shape and np.array_equal(hit[0], a)
+
+
 def _num(x: float) -> str:
     return f"{x:.6g}"
 
@@ -276,8 +281,7 @@ class UnifiedPair:
             return None
         a = np.asarray(a, dtype=float)
         hit = self._fixed
-        if hit is not None and (hit[1] or not with_c2) and hit[0].shape == a.shape \
-                and np.array_equal(hit[0], a):
+        if _held_at(hit, a) and (hit[1] or not with_c2):
             return hit[2]
         laws = [(law, s_.radius) for law, s_ in ((self.law1, self.s1), (self.law2, self.s2))
                 if law is not None]
@@ -319,7 +323,7 @@ class UnifiedPair:
             return 0.0, 0.0, 0.0, 0.0
         a = np.asarray(a, dtype=float)
         hit = self._coupling_last
-        if hit is not None and hit[0].shape == a.shape and np.array_equal(hit[0], a):
+        if _held_at(hit, a):
             return hit[1]
         co = self.coeffs
         s1, d1, P1, m1 = self.law1.plastic_state_at(a / self._rho_hertz[0])
