@@ -1,0 +1,223 @@
+"""How much of the fitted model's misfit a smooth term in its own variables could take away.
+
+The chosen form misses 3 % on about half the runs (``calibration/README.md``, "Where the
+chosen form stops"). Before adding terms, this measures the most any term of the kind the
+form is built from could give: corrections of ln H̄ and ln c² are fitted, by ridge least squares,
+to the F and a errors at the calibration points (``fit.errors``; to first order
+r_F = r_H + (d ln F/d ln h) r_c and r_a = (d ln a/d ln h) r_c, as in ``fit.log_errors``), each
+correction a combination of cubic B-splines in
+
+    ξ = a/R + s n        (s = ``SHIFT``: the FE's c² step lines up in ξ, below)
+
+times the modifiers 1, n, ζ = z/(1 + z) and ln(E/σ_Y)/ln 10⁴ (n the effective exponent,
+z = R/ρ − 1 of the rigid partner). Scores: in-sample, held out
+over the five folds of materials of the cross-validation (``crossval.material_folds``), and on
+the validation set's single-body points with the correction fitted to all calibration points.
+A term of this kind cannot do better than the in-sample figure; if the held-out one does not
+move, the misfit is not a smooth function of these variables.
+
+**The c² step** (:func:`step_positions`): on flats the FE's d ln a/d ln h dips (to 0.32 for a
+stiff perfectly plastic sphere) where c² falls from its plateau; the dip's a/R is read as the
+minimum over a/R 0.25–0.7 of runs that reach a/R 0.62 and dip to ``STEP_DEPTH`` or below, and
+regressed on n (:func:`step_law`). ``python -m spherecontact.calibration.ceiling`` writes
+``reports/calibration/ceiling.json`` and ``ceiling.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from .crossval import material_folds
+from .dataset import Dataset
+from .fit import errors
+from .forms import point_inputs
+
+__all__ = ["SHIFT", "STEP_DEPTH", "basis", "ceiling", "step_positions", "step_law", "main"]
+
+#: ξ = a/R + SHIFT·n: the FE's c² step at ξ ≈ 0.545 for every hardening (``step_law``, v2 database)
+SHIFT = 0.67
+#: a run's c² step counts when its d ln a/d ln h dips to this or below
+STEP_DEPTH = 0.43
+#: B-spline knots on ξ ∈ [0, XI_MAX]
+XI_MAX = 0.9
+#: ridge weight (the basis is a partition of unity: O(1) columns)
+RIDGE = 1e-3
+#: the run error the issue asks for
+TARGET = 0.03
+
+
+def basis(ds: Dataset, coeffs, knots: int = 8, shift: float = SHIFT) -> np.ndarray:
+    """Design matrix (points × 4·(knots + 4)): cubic B-splines in ξ (module docstring), each
+    times 1, n, ζ and ln(E/σ_Y)/ln 10⁴."""
+    n = point_inputs(ds, coeffs)[0]
+    xi = np.clip(ds.x_R + shift * n, 0.0, XI_MAX * (1 - 1e-12))
+    t = np.r_[[0.0] * 4, np.linspace(0.0, XI_MAX, knots + 2)[1:-1], [XI_MAX] * 4]
+    B = BSpline.design_matrix(xi, t, 3).toarray()
+    z = np.asarray([_z(c) for c in ds.curves])[ds.run]
+    sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
+    lnE = np.log(ds.E_prime / sy) / math.log(1e4)
+    return np.hstack([B * m[:, None] for m in (np.ones_like(xi), n, z / (1.0 + z), lnE)])
+
+
+def _z(curve) -> float:
+    return 0.0 if math.isinf(curve.indenter_radius) else curve.radius / curve.rho - 1.0
+
+
+def _fit(ds: Dataset, e: dict, X: np.ndarray, keep: np.ndarray,
+         ridge: float) -> tuple[np.ndarray, np.ndarray]:
+    """Coefficients of the ln H̄ and ln c² corrections fitted to the F and a errors of the
+    points ``keep`` (ridge least squares)."""
+    rF, ra = _corrected(ds, e, 0.0, 0.0)
+    Xk, sF, sa = X[keep], ds.slope_F[keep, None], ds.slope_a[keep, None]
+    A = np.block([[Xk, sF * Xk], [np.zeros_like(Xk), sa * Xk]])
+    w = np.linalg.solve(A.T @ A + ridge * np.eye(A.shape[1]), A.T @ np.r_[rF[keep], ra[keep]])
+    k = X.shape[1]
+    return w[:k], w[k:]
+
+
+def _corrected(ds: Dataset, e: dict, dH, dc) -> tuple[np.ndarray, np.ndarray]:
+    """r_F, r_a after subtracting dH, dc from the ln H̄, ln c² errors."""
+    rH, rc = np.log1p(e["H_bar"]) - dH, np.log1p(e["c2"]) - dc
+    return rH + ds.slope_F * rc, ds.slope_a * rc
+
+
+def _scores(ds: Dataset, rF: np.ndarray, ra: np.ndarray, worst: int = 3) -> dict:
+    """RMS and max in %, runs whose larger max exceeds ``TARGET`` and the ``worst`` runs (key,
+    max %, a/R where it sits)."""
+    pct = lambda v: round(100.0 * float(v), 2)  # noqa: E731
+    big = np.maximum(np.abs(rF), np.abs(ra))
+    runs = []
+    for i, c in enumerate(ds.curves):
+        m = np.flatnonzero(ds.run == i)
+        j = m[np.argmax(big[m])]
+        runs.append((float(big[j]), c.key, round(float(ds.x_R[j]), 3)))
+    runs.sort(reverse=True)
+    return {"F_rms_pct": pct(np.sqrt(np.mean(rF ** 2))), "F_max_pct": pct(np.abs(rF).max()),
+            "a_rms_pct": pct(np.sqrt(np.mean(ra ** 2))), "a_max_pct": pct(np.abs(ra).max()),
+            "runs": len(runs), "runs_above_target": sum(r[0] > TARGET for r in runs),
+            "worst": [{"run": k, "max_pct": pct(v), "a_over_R": x} for v, k, x in runs[:worst]]}
+
+
+def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
+            ridge: float = RIDGE) -> dict:
+    """Scores (RMS and max of the F and a errors in %, runs whose larger max exceeds
+    ``TARGET``) of the fitted model and of it with the correction: in-sample, held out by
+    folds of materials, and on ``val`` (module docstring)."""
+    e = errors(cal, coeffs)
+    X = basis(cal, coeffs, knots)
+    out = {"parameters": 2 * X.shape[1], "knots": knots, "shift": SHIFT, "ridge": ridge,
+           "model": _scores(cal, *_corrected(cal, e, 0.0, 0.0))}
+    wH, wc = _fit(cal, e, X, np.ones(cal.size, bool), ridge)
+    out["in_sample"] = _scores(cal, *_corrected(cal, e, X @ wH, X @ wc))
+    dH, dc = np.empty(cal.size), np.empty(cal.size)
+    groups = np.asarray([c.group for c in cal.curves])[cal.run]
+    for held in material_folds(cal.groups):
+        test = np.isin(groups, held)
+        fH, fc = _fit(cal, e, X, ~test, ridge)
+        dH[test], dc[test] = X[test] @ fH, X[test] @ fc
+    out["held_out"] = _scores(cal, *_corrected(cal, e, dH, dc))
+    if val is not None:
+        ev, Xv = errors(val, coeffs), basis(val, coeffs, knots)
+        out["validation_model"] = _scores(val, *_corrected(val, ev, 0.0, 0.0))
+        out["validation"] = _scores(val, *_corrected(val, ev, Xv @ wH, Xv @ wc))
+    return out
+
+
+def step_positions(ds: Dataset, coeffs, lo: float = 0.25, hi: float = 0.7, reach: float = 0.62,
+                   depth: float = STEP_DEPTH) -> list[dict]:
+    """Flats whose FE c² steps (module docstring): key, a/R of the step, the slope there and n."""
+    n = point_inputs(ds, coeffs)[0]
+    rows = []
+    for i, c in enumerate(ds.curves):
+        m = ds.run == i
+        x, s = ds.x_R[m], ds.slope_a[m]
+        inside = (x > lo) & (x < hi)
+        if not math.isinf(c.indenter_radius) or x.max() < reach or np.count_nonzero(inside) < 5:
+            continue
+        j = int(np.argmin(np.where(inside, s, np.inf)))
+        if s[j] <= depth:
+            rows.append({"key": c.key, "a_over_R": float(x[j]), "slope": float(s[j]), "n": float(n[m][j])})
+    return rows
+
+
+def step_law(rows: list[dict]) -> dict:
+    """Least-squares a/R_step = x₀ + x_n n over ``rows``, its RMS residual, the spread of the
+    positions and the correlation."""
+    x = np.array([r["a_over_R"] for r in rows])
+    n = np.array([r["n"] for r in rows])
+    A = np.c_[np.ones_like(n), n]
+    w = np.linalg.lstsq(A, x, rcond=None)[0]
+    return {"x0": float(w[0]), "x_n": float(w[1]), "rms": float(np.sqrt(np.mean((A @ w - x) ** 2))),
+            "spread": float(x.std()), "correlation": float(np.corrcoef(n, x)[0, 1]), "runs": int(x.size)}
+
+
+def _chart(cal: Dataset, coeffs, rows: list[dict], law: dict, out: Path) -> Path:
+    from ..validation.charts import pyplot
+
+    plt = pyplot()
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(12, 4.5))
+    n = np.array([r["n"] for r in rows])
+    ax0.plot(n, [r["a_over_R"] for r in rows], "o", ms=4)
+    nn = np.linspace(0.0, n.max(), 2)
+    ax0.plot(nn, law["x0"] + law["x_n"] * nn, "k-", lw=1,
+             label=f"a/R = {law['x0']:.3f} {law['x_n']:+.2f} n (RMS {law['rms']:.3f})")
+    ax0.set(xlabel="effective hardening exponent n", ylabel="a/R of the FE's c² step",
+            title="where c² steps (flats)")
+    ax0.legend()
+    e = errors(cal, coeffs)
+    rF = np.log1p(e["F"])
+    xi = cal.x_R + SHIFT * point_inputs(cal, coeffs)[0]
+    for i, c in enumerate(cal.curves):
+        if math.isinf(c.indenter_radius):
+            m = cal.run == i
+            ax1.plot(xi[m], 100 * rF[m], lw=0.6, alpha=0.7)
+    for y in (-100 * TARGET, 100 * TARGET):
+        ax1.axhline(y, color="k", lw=0.6)
+    ax1.set(xlabel=f"ξ = a/R + {SHIFT} n", ylabel="model/FE − 1 of F, %", title="calibration flats: F error")
+    fig.tight_layout()
+    fig.savefig(out, dpi=90)
+    plt.close(fig)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    import warnings
+
+    from ..data import Database
+    from ..model import load_coefficients
+    from .dataset import build_dataset
+
+    p = argparse.ArgumentParser(prog="python -m spherecontact.calibration.ceiling",
+                                description=__doc__.split("\n\n")[0])
+    p.add_argument("--db", default="data/reference_v2.h5")
+    p.add_argument("--coefficients", default="data/coefficients.json")
+    p.add_argument("--out", default="reports/calibration")
+    a = p.parse_args(argv)
+    co = load_coefficients(a.coefficients)
+    db = Database(a.db)
+    one_body = lambda rec: rec.inputs.get("scene") != "two_body"  # noqa: E731
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the validation set reaches past the calibrated range
+        sets = {s: build_dataset([(f"{r.case} [{r.key}]", run)
+                                  for r, run in db.runs(set=s, status=None, where=one_body)])
+                for s in ("calibration", "validation")}
+        result = {k: ceiling(sets["calibration"], co, sets["validation"], k) for k in (6, 8, 12)}
+    rows = step_positions(sets["calibration"], co) + step_positions(sets["validation"], co)
+    law = step_law(rows)
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    record = {"correction": result, "c2_step": {"law": law, "runs": rows}}
+    (out / "ceiling.json").write_text(json.dumps(record, indent=1) + "\n")
+    _chart(sets["calibration"], co, rows, law, out / "ceiling.png")
+    print(json.dumps({"correction": result, "c2_step": law}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
