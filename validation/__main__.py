@@ -19,6 +19,8 @@ from pathlib import Path
 
 
 def _parser() -> argparse.ArgumentParser:
+    from .increments_report import DEFAULT_PATH as CONVERGED_FE
+
     p = argparse.ArgumentParser(prog="python -m spherecontact.validation",
                                 description=__doc__.splitlines()[0])
     p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
@@ -35,7 +37,7 @@ def _parser() -> argparse.ArgumentParser:
                         "committed)")
     p.add_argument("--mdr", default="data/peers/mdr.json",
                    help="stored LAMMPS mdr curves (JSON; a missing file leaves mdr out)")
-    p.add_argument("--converged-fe", default="reports/fem/increments_validation.json",
+    p.add_argument("--converged-fe", default=str(CONVERGED_FE),
                    help="first loadings re-run with increments dh <= r h (make verify-increments; a "
                         "missing file leaves the section out)")
     p.add_argument("--study-runs", default="reports/validation/studies",
