@@ -3,7 +3,7 @@
 The chosen form misses 3 % on about half the runs (``calibration/README.md``, "Where the
 chosen form stops"). Before adding terms, this measures the most any term of the kind the
 form is built from could give: corrections of ln H̄ and ln c² are fitted, by ridge least squares,
-to the F and a errors at the calibration points (``fit.errors``; to first order
+to the F and a errors at the calibration points (to first order
 r_F = r_H + (d ln F/d ln h) r_c and r_a = (d ln a/d ln h) r_c, as in ``fit.log_errors``), each
 correction a combination of cubic B-splines in
 
@@ -35,8 +35,8 @@ from scipy.interpolate import BSpline
 
 from .crossval import material_folds
 from .dataset import Dataset
-from .fit import errors
-from .forms import point_inputs
+from .fit import log_errors
+from .forms import point_inputs, predict, raw_curvature_ratio
 
 __all__ = ["SHIFT", "STEP_DEPTH", "basis", "ceiling", "step_positions", "step_law", "main"]
 
@@ -59,21 +59,17 @@ def basis(ds: Dataset, coeffs, knots: int = 8, shift: float = SHIFT) -> np.ndarr
     xi = np.clip(ds.x_R + shift * n, 0.0, XI_MAX * (1 - 1e-12))
     t = np.r_[[0.0] * 4, np.linspace(0.0, XI_MAX, knots + 2)[1:-1], [XI_MAX] * 4]
     B = BSpline.design_matrix(xi, t, 3).toarray()
-    z = np.asarray([_z(c) for c in ds.curves])[ds.run]
+    z = raw_curvature_ratio(ds)
     sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
     lnE = np.log(ds.E_prime / sy) / math.log(1e4)
     return np.hstack([B * m[:, None] for m in (np.ones_like(xi), n, z / (1.0 + z), lnE)])
 
 
-def _z(curve) -> float:
-    return 0.0 if math.isinf(curve.indenter_radius) else curve.radius / curve.rho - 1.0
-
-
-def _fit(ds: Dataset, e: dict, X: np.ndarray, keep: np.ndarray,
+def _fit(ds: Dataset, r0: tuple, X: np.ndarray, keep: np.ndarray,
          ridge: float) -> tuple[np.ndarray, np.ndarray]:
-    """Coefficients of the ln H̄ and ln c² corrections fitted to the F and a errors of the
-    points ``keep`` (ridge least squares)."""
-    rF, ra = _corrected(ds, e, 0.0, 0.0)
+    """Coefficients of the ln H̄ and ln c² corrections fitted to the model's F and a errors
+    ``r0`` = (r_F, r_a) at the points ``keep`` (ridge least squares)."""
+    rF, ra = r0
     Xk, sF, sa = X[keep], ds.slope_F[keep, None], ds.slope_a[keep, None]
     A = np.block([[Xk, sF * Xk], [np.zeros_like(Xk), sa * Xk]])
     w = np.linalg.solve(A.T @ A + ridge * np.eye(A.shape[1]), A.T @ np.r_[rF[keep], ra[keep]])
@@ -81,10 +77,11 @@ def _fit(ds: Dataset, e: dict, X: np.ndarray, keep: np.ndarray,
     return w[:k], w[k:]
 
 
-def _corrected(ds: Dataset, e: dict, dH, dc) -> tuple[np.ndarray, np.ndarray]:
-    """r_F, r_a after subtracting dH, dc from the ln H̄, ln c² errors."""
-    rH, rc = np.log1p(e["H_bar"]) - dH, np.log1p(e["c2"]) - dc
-    return rH + ds.slope_F * rc, ds.slope_a * rc
+def _corrected(ds: Dataset, model: tuple, dH=0.0, dc=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """r_F, r_a (``fit.log_errors``) of the model's p_m, c² = ``model`` with ln H̄ and ln c²
+    corrected by −dH, −dc."""
+    p, c = model
+    return log_errors(ds, p * np.exp(-dH), c * np.exp(-dc))
 
 
 def _scores(ds: Dataset, rF: np.ndarray, ra: np.ndarray, worst: int = 3) -> dict:
@@ -109,23 +106,24 @@ def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
     """Scores (RMS and max of the F and a errors in %, runs whose larger max exceeds
     ``TARGET``) of the fitted model and of it with the correction: in-sample, held out by
     folds of materials, and on ``val`` (module docstring)."""
-    e = errors(cal, coeffs)
+    model = predict(cal, coeffs)
+    r0 = _corrected(cal, model)
     X = basis(cal, coeffs, knots)
     out = {"parameters": 2 * X.shape[1], "knots": knots, "shift": SHIFT, "ridge": ridge,
-           "model": _scores(cal, *_corrected(cal, e, 0.0, 0.0))}
-    wH, wc = _fit(cal, e, X, np.ones(cal.size, bool), ridge)
-    out["in_sample"] = _scores(cal, *_corrected(cal, e, X @ wH, X @ wc))
+           "model": _scores(cal, *r0)}
+    wH, wc = _fit(cal, r0, X, np.ones(cal.size, bool), ridge)
+    out["in_sample"] = _scores(cal, *_corrected(cal, model, X @ wH, X @ wc))
     dH, dc = np.empty(cal.size), np.empty(cal.size)
     groups = np.asarray([c.group for c in cal.curves])[cal.run]
     for held in material_folds(cal.groups):
         test = np.isin(groups, held)
-        fH, fc = _fit(cal, e, X, ~test, ridge)
+        fH, fc = _fit(cal, r0, X, ~test, ridge)
         dH[test], dc[test] = X[test] @ fH, X[test] @ fc
-    out["held_out"] = _scores(cal, *_corrected(cal, e, dH, dc))
+    out["held_out"] = _scores(cal, *_corrected(cal, model, dH, dc))
     if val is not None:
-        ev, Xv = errors(val, coeffs), basis(val, coeffs, knots)
-        out["validation_model"] = _scores(val, *_corrected(val, ev, 0.0, 0.0))
-        out["validation"] = _scores(val, *_corrected(val, ev, Xv @ wH, Xv @ wc))
+        mv, Xv = predict(val, coeffs), basis(val, coeffs, knots)
+        out["validation_model"] = _scores(val, *_corrected(val, mv))
+        out["validation"] = _scores(val, *_corrected(val, mv, Xv @ wH, Xv @ wc))
     return out
 
 
@@ -170,8 +168,7 @@ def _chart(cal: Dataset, coeffs, rows: list[dict], law: dict, out: Path) -> Path
     ax0.set(xlabel="effective hardening exponent n", ylabel="a/R of the FE's c² step",
             title="where c² steps (flats)")
     ax0.legend()
-    e = errors(cal, coeffs)
-    rF = np.log1p(e["F"])
+    rF = _corrected(cal, predict(cal, coeffs))[0]
     xi = cal.x_R + SHIFT * point_inputs(cal, coeffs)[0]
     for i, c in enumerate(cal.curves):
         if math.isinf(c.indenter_radius):
