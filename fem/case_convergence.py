@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -23,8 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from ..validation.metrics import interp_loglog
-from .io import material_from_description, run_indentation
-from .solver import SolverOptions
+from .design import run_kwargs
+from .io import run_indentation
 
 __all__ = ["A_OVER_R", "rerun", "differences", "check_case", "main"]
 
@@ -37,13 +38,10 @@ def rerun(inputs: dict, density: float, h_max: float | None = None) -> dict:
     cycles; returns wall time, dofs, status and the curves h, F, a."""
     if inputs.get("scene") == "two_body":
         raise ValueError("rerun: one-body scenes only (flat or rigid sphere); got a two-body run")
-    options = {k: v for k, v in inputs["options"].items() if k != "max_wall_s"}
+    kw = run_kwargs(inputs, max_wall_s=math.inf)
+    kw.update(density=density, unload_at=None, h_max=kw["h_max"] if h_max is None else h_max)
     t0 = time.perf_counter()
-    res = run_indentation(material_from_description(inputs["material"]), float(inputs["radius"]),
-                          float(h_max if h_max is not None else inputs["h_max"]),
-                          indenter_radius=float(inputs["indenter_radius"]), density=density,
-                          element=inputs["element"], edge_band=float(inputs.get("edge_band", 0.0)),
-                          options=SolverOptions(**options))
+    res = run_indentation(**kw)
     return {"density": density, "status": res.status, "wall_s": time.perf_counter() - t0,
             "n_dofs": res.inputs["n_dofs"], "h": res.h.tolist(), "F": res.F.tolist(), "a": res.a.tolist()}
 
@@ -66,10 +64,9 @@ def differences(reference: dict, others: dict[str, dict], radius: float, at=A_OV
 
 
 def _stored_loading(run) -> dict:
-    keep = getattr(run, "reference", getattr(run, "loading", None))
-    keep = np.ones(run.h.size, bool) if keep is None else np.asarray(keep, bool)
-    order = np.argsort(run.h[keep], kind="stable")
-    return {q: np.asarray(getattr(run, q))[keep][order].tolist() for q in ("h", "F", "a")}
+    """The stored run's loading increments (``Run.reference``: no cycles, no first-step transient)."""
+    keep = np.asarray(run.reference, bool)
+    return {q: np.asarray(getattr(run, q))[keep].tolist() for q in ("h", "F", "a")}
 
 
 def check_case(db_path, case: str, workers: int = 2) -> dict:

@@ -49,7 +49,8 @@ from .io import material_from_description
 from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN, check_band_floor
 from .solver import SolverOptions
 
-__all__ = ["PARAMETERS", "SCENES", "Param", "Case", "Campaign", "load_campaign", "parse_campaign"]
+__all__ = ["PARAMETERS", "SCENES", "Param", "Case", "Campaign", "load_campaign", "parse_campaign",
+           "run_kwargs"]
 
 SCENES = ("flat", "rigid_sphere", "two_body")
 _TWO = ("two_body",)
@@ -169,6 +170,23 @@ SAMPLE_DIGITS = 3
 
 
 # ============================================================================ cases
+def run_kwargs(inputs: dict, **options) -> dict:
+    """Keyword arguments of ``fem.io.run_indentation`` for the inputs of a run: a campaign case's
+    (:meth:`Case.run_kwargs`) or a stored run's (``Run.inputs``); ``options`` replace recorded
+    solver options (e.g. ``max_wall_s``). Two bodies when the inputs name body 2's radius."""
+    i = inputs
+    kw = {"material": material_from_description(i["material"]), "radius": i["radius"],
+          "h_max": i["h_max"], "density": i["mesh_density"], "element": i["element"],
+          "options": SolverOptions(**{**i["options"], **options}),
+          "edge_band": i.get("edge_band", 0.0), "band_floor": i.get("band_floor"),
+          "unload_at": i.get("unload_at")}
+    if "radius2" in i:
+        kw.update(radius2=i["radius2"], material2=material_from_description(i["material2"]))
+    else:
+        kw["indenter_radius"] = i["indenter_radius"]
+    return kw
+
+
 @dataclass(frozen=True)
 class Case:
     """One expanded campaign case: names, parameters, and the inputs of its FE run.
@@ -198,17 +216,7 @@ class Case:
 
     def run_kwargs(self) -> dict:
         """Keyword arguments of ``fem.io.run_indentation`` for this case."""
-        i = self.inputs
-        kw = {"material": material_from_description(i["material"]), "radius": i["radius"],
-              "h_max": i["h_max"], "density": i["mesh_density"], "element": i["element"],
-              "options": SolverOptions(**i["options"], max_wall_s=self.max_wall_s),
-              "edge_band": i.get("edge_band", 0.0), "band_floor": i.get("band_floor"),
-              "unload_at": i.get("unload_at")}
-        if self.scene == "two_body":
-            kw.update(radius2=i["radius2"], material2=material_from_description(i["material2"]))
-        else:
-            kw["indenter_radius"] = i["indenter_radius"]
-        return kw
+        return run_kwargs(self.inputs, max_wall_s=self.max_wall_s)
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,7 @@ from spherecontact.fem.case_convergence import check_case, differences, rerun
 #: a campaign v2 flat's recorded inputs (options as the campaign writes them)
 INPUTS = {"edge_band": 0.03, "element": "q8r", "h_max": 0.3, "indenter_radius": math.inf,
           "material": {"E": 200.0, "nu": 0.3, "sigma_y": 1.0, "K": 0.0, "n": 1.0}, "radius": 1.0,
-          "scene": "rigid_flat",
+          "mesh_density": 1.0, "scene": "rigid_flat", "unload_at": [0.01, 0.03, 0.1, 0.3],
           "options": {"dh_first": 0.0002, "dh_max": 0.01, "dh_min": 1e-07, "easy_iterations": 7,
                       "growth": 1.5, "line_search": True, "linear_solver": "ldl", "max_iterations": 25,
                       "max_wall_s": 5400.0, "segment_points": 0, "strain_increment": 0.005,
@@ -40,8 +40,10 @@ def test_differences_leave_out_radii_the_other_curve_does_not_reach():
 
 
 def test_rerun_repeats_a_stored_scene_from_its_inputs():
-    r = rerun(INPUTS, 1.0, h_max=0.002)
-    assert r["status"] == "converged" and r["h"][-1] == pytest.approx(0.002)
+    """The recorded scene without its cycles (the first unloading would come at 0.01)."""
+    r = rerun(INPUTS, 1.0, h_max=0.02)
+    assert r["status"] == "converged" and r["h"][-1] == pytest.approx(0.02)
+    assert np.all(np.diff(r["h"]) > 0)
     assert r["n_dofs"] > 0 and r["F"][-1] > 0
 
 
