@@ -297,11 +297,11 @@ def _add_numerics(add) -> None:
         help="with --penalty (one body on a rigid flat or sphere): integrate the contact pressure "
              "at this many Gauss points per surface edge, 1-64 (default 0: at the nodes)")
     add(grp, "--penalty-scale", choices=PENALTY_SCALES, default=_DEFAULTS.penalty_scale,
-        help="with --penalty (one body): 'modulus' (default), stiffness penalty * E / (pole "
-             "element length); 'approach', stiffness penalty * p_m / h, so the obstacle presses "
-             "in by about h / penalty at every approach (use with --segment-points; README, "
-             "'Smoothness of F'). With penalty contact the curve h is the body's own shortening "
-             "and h_applied the obstacle's travel")
+        help="with --penalty: 'modulus' (default), stiffness penalty * E / (pole element "
+             "length); 'approach', stiffness penalty * p_m / h, so the obstacle (or the other "
+             "body) presses in by about h / penalty at every approach (one body: use with "
+             "--segment-points; README, 'Smoothness of F'). The curve h is then the bodies' own "
+             "shortening and h_applied the travel of the equator(s)")
     add(grp, "--linear-solver", choices=LINEAR_METHODS, default=_DEFAULTS.linear_solver,
         help="sparse factorisation: 'cholesky' (CHOLMOD's supernodal Cholesky reusing its "
              "analysis, LDL^T where the tangent is not positive definite; default), 'ldl' (qdldl "

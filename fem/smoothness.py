@@ -78,6 +78,13 @@ CASES = [
      0.02, {**APPROACH, "relative_step": 0.1, "band_floor": 0.0002}),
     ("flat E1000, band 0.02, approach penalty 300, steps ≤ 0.1 h", 1000.0, math.inf, 0.02,
      {**APPROACH, "relative_step": 0.1}),
+    # the increment-converged settings together: Newton 1e-8, the secant predictor, steps ≤ 0.1 h
+    # and the band's floor 0.0002 of R; and a softer approach penalty under 1e-8 and the secant
+    ("flat E10000, band 0.02 floor 0.0002, approach penalty 300, steps ≤ 0.1 h, Newton 1e-8, secant",
+     10000.0, math.inf, 0.02,
+     {**APPROACH, "relative_step": 0.1, "band_floor": 0.0002, "tol": 1e-8, "predictor": "secant"}),
+    ("flat E10000, band 0.02, approach penalty 150, Newton 1e-8, secant", 10000.0, math.inf, 0.02,
+     {**APPROACH, "penalty": 150.0, "tol": 1e-8, "predictor": "secant"}),
 ]
 BANDS = ((0.01, 0.03), (0.03, 0.1), (0.1, 0.3), (0.3, 1.2))
 

@@ -123,7 +123,7 @@ class SolverOptions:
     #: 0: penalty at the nodes; n > 0: penalty pressure integrated at n Gauss points per surface
     #: edge (segment_penalty.py), which needs ``penalty``
     segment_points: int = 0
-    #: how ``penalty`` sets k_N (one body): "modulus", k_N = penalty · E / ℓ; "approach",
+    #: how ``penalty`` sets k_N: "modulus", k_N = penalty · E / ℓ; "approach",
     #: k_N = penalty · p_m / h (p_m = F/πa² of the last converged loading increment, Hertz's
     #: before contact), so the obstacle is pressed in by about h / penalty at every approach and
     #: a surface edge that closes takes its pressure over a penetration of that size instead of
@@ -374,6 +374,17 @@ def bracketed_line_search(slope, s0: float, max_steps: int = 4):
             hi, s_hi = alpha, s_a
         alpha = float(np.clip(lo + (hi - lo) * s_lo / (s_lo - s_hi), lo + 0.5 * (hi - lo), hi))
     return below or tried
+
+
+def approach_stiffness(penalty: float, run: _RunState, h_new: float, E_prime: float, R_rel: float) -> float:
+    """k_N = penalty · p_m / h_new (``penalty_scale`` "approach"): the contact is pressed in by
+    about h/penalty at every approach. p_m is the last converged increment's F/(πa²), or Hertz's
+    4E′√(h/R*)/(3π) before contact (E′ the pair's contact modulus, R* its relative radius)."""
+    if run.F > 0.0 and run.a > 0.0:
+        p_m = run.F / (np.pi * run.a**2)
+    else:
+        p_m = 4.0 * E_prime * np.sqrt(h_new / R_rel) / (3.0 * np.pi)
+    return penalty * p_m / h_new
 
 
 def freeze_toggling(log: dict, plastic: np.ndarray, elastic: np.ndarray | None) -> np.ndarray | None:
@@ -1132,17 +1143,11 @@ class IndentationSolver(CycleLegs):
         and F(h) climbs in steps of about 2Δs/a. With the pressure integrated over the edges
         (``segment_points``) and k_N = P p_m/h, a closing edge is pressed in over about h/P and
         takes its pressure gradually; the penetration is then the same fraction 1/P of the
-        approach at every h, and the body's own shortening (curve ``h``) excludes it.
-        p_m is the last converged loading increment's F/(πa²), or Hertz's 4E′√(h/R*)/(3π) before
-        contact.
+        approach at every h, and the body's own shortening (curve ``h``) excludes it
+        (:func:`approach_stiffness`).
         """
-        if run.F > 0.0 and run.a > 0.0:
-            p_m = run.F / (np.pi * run.a**2)
-        else:
-            E_prime = self._pair_modulus()
-            R_rel = 1.0 / (1.0 / self.radius + 1.0 / self.obstacle.radius)
-            p_m = 4.0 * E_prime * np.sqrt(h_new / R_rel) / (3.0 * np.pi)
-        self.k_penalty = self.options.penalty * p_m / h_new
+        R_rel = 1.0 / (1.0 / self.radius + 1.0 / self.obstacle.radius)
+        self.k_penalty = approach_stiffness(self.options.penalty, run, h_new, self._pair_modulus(), R_rel)
         if self.segments is not None:
             self.segments.k_n = self.k_penalty
 

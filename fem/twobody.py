@@ -48,6 +48,7 @@ from .solver import (
     SolverOptions,
     _RunState,
     admissible_step,
+    approach_stiffness,
     bracketed_line_search,
     check_unload_at,
     cycles_as_arrays,
@@ -81,6 +82,13 @@ ZONE_GROWTH = 1.25
 #: increment on that pair against 3.8, and at 1e-8 the run had not finished after 31 min where
 #: the exact tangent took 20
 PENALTY_PAIR_TOL = 1e-8
+#: the approach-scaled penalty of two bodies presses them into each other by at most this
+#: fraction of the smallest surface node spacing (k_N ≥ p_m / (APPROACH_DEPTH · spacing)): a
+#: slave node sunk about a node spacing below a master surface that the nodal forces make wavy
+#: at that scale has no unique closest point. The pair E₂ = 3E₁, R₂ = 2R₁ (band 0.03, nodes
+#: 2.7e-4 R₁ apart near the pole) stalled with h/P alone at h/P = 2.2e-4 / 1.7e-4 / 1.5e-4 R₁
+#: (P = 300 / 500 / 1000, Newton cycling at 1e-6 … 1e-3 on surface nodes at r ≈ 0.012 R₁)
+APPROACH_DEPTH = 0.25
 #: trials of the two-body line search (:func:`~.solver.bracketed_line_search`): the bench pair
 #: (E₂ = 3E₁, R₂ = 2R₁, penalty 100, to h = 0.03 R₁) with 4 / 6 / 8 / 12: 103 / 82 / 78 / 78
 #: increments, 4 / 2 / 1 / 1 of them failed, 717 / 632 / 567 / 561 Newton iterations
@@ -316,6 +324,10 @@ class TwoBodySolver(CycleLegs):
     nodes against the other's surface, half the stiffness each) with
     k_N = penalty · E*/ℓ, E* the pair's contact modulus and ℓ the length of the pole's
     surface element. An equal pair is then exactly symmetric under exchange of the bodies.
+    With ``penalty_scale`` "approach", k_N = penalty · p_m/h (:func:`~.solver.approach_stiffness`,
+    fixed on unloading and reloading): the bodies press into each other by about h/penalty, so a
+    surface node that closes takes its pressure over that penetration; the curve ``h`` is then
+    h₁ + h₂, the bodies' own shortening, and ``h_applied`` the equators' travel.
     """
 
     def __init__(self, material1: Material, radius1: float, material2: Material, radius2: float,
@@ -342,9 +354,6 @@ class TwoBodySolver(CycleLegs):
         self.slave = self.bodies[self.slave_index]
         self.master = self.bodies[1 - self.slave_index]
         self.k_penalty = None
-        if self.options.penalty_scale != "modulus":
-            raise ValueError(f"two deformable bodies take penalty_scale 'modulus' only, got "
-                             f"{self.options.penalty_scale!r}")
         if self.options.penalty is None:
             self.passes = [ContactPass(self.slave, self.master, self.n_dofs)]
         else:
@@ -355,6 +364,9 @@ class TwoBodySolver(CycleLegs):
             e_star = 1.0 / (1.0 / material1.E_prime + 1.0 / material2.E_prime)
             self.k_penalty = self.options.penalty * e_star / pole_edge
         self.contact = self.passes[0]
+        #: the smallest distance between neighbouring surface nodes of either body
+        self._surface_spacing = min(float(np.hypot(*np.diff(b.hmesh.X[:, b.hmesh.surface], axis=1)).min())
+                                    for b in self.bodies)
         self.candidates = self.contact.candidates
         fixed = []
         for b in self.bodies:
@@ -719,6 +731,10 @@ class TwoBodySolver(CycleLegs):
         self._profiles = ([], [], [], [])  # residuals, r, p, gap per increment
         self._progress = progress
         cycles = self._walk(run, h_max, unload)
+        if self.options.penalty_scale == "approach":  # peaks in the bodies' own shortening
+            h1, h2 = self._hist.h1, self._hist.h2
+            for cycle in cycles:
+                cycle["h_max"] = h1[cycle["increment_peak"]] + h2[cycle["increment_peak"]]
         residuals, prof_r, prof_p, prof_g = self._profiles
         result = self._result(vars(self._hist), residuals, prof_r, prof_p, prof_g, run.status, run.reason,
                               run.u, run.state, h_max, time.perf_counter() - run.t_start)
@@ -761,6 +777,12 @@ class TwoBodySolver(CycleLegs):
     def _solve(self, run: _RunState, h_new: float):
         """Newton for one increment to ``h_new``: the converged tuple, or the exception."""
         dh = h_new - run.h
+        if self.options.penalty_scale == "approach" and h_new > run.h_top:
+            b1, b2 = self.bodies
+            R_rel = 1.0 / (1.0 / b1.radius + 1.0 / b2.radius)
+            k = approach_stiffness(self.options.penalty, run, h_new, self._pair_modulus(), R_rel)
+            p_m = k * h_new / self.options.penalty
+            self.k_penalty = max(k, p_m / (APPROACH_DEPTH * self._surface_spacing))
         u_pred = self._predicted(run, dh, lambda: self._predictor(dh) if run.h == 0.0 else run.u.copy())
         u_pred = self._apply_bc(u_pred, h_new)
         try:
@@ -839,7 +861,12 @@ class TwoBodySolver(CycleLegs):
         run.last_iterations = its
 
     def _result(self, rec, residuals, prof_r, prof_p, prof_g, status, reason, u, states, h_max, wall):
-        curves = finish_curves({k: np.asarray(v, dtype=float) for k, v in rec.items()})
+        curves = {k: np.asarray(v, dtype=float) for k, v in rec.items()}
+        if self.options.penalty_scale == "approach":  # the bodies press into each other by ~h/P
+            curves["h_applied"] = curves["h"]
+            curves["h"] = curves["h1"] + curves["h2"]  # the bodies' own shortening
+            curves["penetration"] = curves["h_applied"] - curves["h"]
+        curves = finish_curves(curves)
         n = self.candidates.size
         timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
                    **{f"linear_{k}": v for k, v in self.linear.stats.items()},

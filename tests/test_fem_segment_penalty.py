@@ -146,13 +146,27 @@ def test_penalty_scale_is_checked():
         SolverOptions(penalty_scale="approach").validate()
 
 
-def test_two_bodies_refuse_the_approach_scaled_penalty():
+def test_two_bodies_take_the_approach_scaled_penalty():
+    """Two deformable bodies, k_N = P p_m / h: they press into each other by about h/P, the stored
+    h is h₁ + h₂ (the bodies' own shortening) and h_applied the equators' travel, and F(h) stays
+    on the modulus-scaled penalty's curve (whose penetration is ~1e-4 of h)."""
     from spherecontact.fem.twobody import TwoBodySolver
     from spherecontact.model.material import Material
 
-    m = Material(E=200.0, nu=0.3, sigma_y=1.0)
-    with pytest.raises(ValueError, match="penalty_scale 'modulus' only"):
-        TwoBodySolver(m, 1.0, m, 2.0, options=SolverOptions(penalty=1.0, penalty_scale="approach"))
+    P, h_max = 300.0, 3e-3
+    m1, m2 = Material(E=200.0, nu=0.3, sigma_y=1.0), Material(E=600.0, nu=0.3, sigma_y=1.0)
+    approach = SolverOptions(penalty=P, penalty_scale="approach")
+    soft = TwoBodySolver(m1, 1.0, m2, 2.0, options=approach).run(h_max)
+    stiff = TwoBodySolver(m1, 1.0, m2, 2.0, options=SolverOptions(penalty=100.0)).run(h_max)
+    c = soft.curves
+    assert soft.status == "converged" and np.all(np.diff(c["h"]) > 0)
+    assert np.allclose(c["h"], c["h1"] + c["h2"], rtol=0, atol=1e-15)
+    late = c["h_applied"] > 1e-3
+    assert np.all(c["penetration"][late] > 0.2 * c["h_applied"][late] / P)
+    assert np.all(c["penetration"][late] < 3.0 * c["h_applied"][late] / P)
+    assert "h_applied" not in stiff.curves  # the modulus-scaled penalty keeps h as applied
+    F_stiff = np.interp(c["h"][-1], stiff.h, stiff.F)
+    assert c["F"][-1] == pytest.approx(F_stiff, rel=0.015)
 
 
 def test_loading_steps_keep_the_strain_increment_from_the_first_one_on():
