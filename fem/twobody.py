@@ -83,12 +83,15 @@ ZONE_GROWTH = 1.25
 #: the exact tangent took 20
 PENALTY_PAIR_TOL = 1e-8
 #: the approach-scaled penalty of two bodies presses them into each other by at most this
-#: fraction of the smallest surface node spacing (k_N ≥ p_m / (APPROACH_DEPTH · spacing)): a
-#: slave node sunk about a node spacing below a master surface that the nodal forces make wavy
-#: at that scale has no unique closest point. The pair E₂ = 3E₁, R₂ = 2R₁ (band 0.03, nodes
-#: 2.7e-4 R₁ apart near the pole) stalled with h/P alone at h/P = 2.2e-4 / 1.7e-4 / 1.5e-4 R₁
-#: (P = 300 / 500 / 1000, Newton cycling at 1e-6 … 1e-3 on surface nodes at r ≈ 0.012 R₁)
-APPROACH_DEPTH = 0.25
+#: fraction of the smallest surface node spacing s (k_N ≥ p_m / (APPROACH_DEPTH · s)): a slave
+#: node sunk a good part of a node spacing below a master surface that the nodal forces make
+#: wavy at that scale has no unique closest point, and Newton cycles. Pair E₂ = 3E₁, R₂ = 2R₁
+#: (band 0.03, s = 2.7e-4 R₁ near the pole), with h/P alone: stalled at h/P = 2.2e-4 / 1.7e-4 /
+#: 1.5e-4 R₁ (P = 300 / 500 / 1000; residuals cycling at 1e-6 … 1e-3 on surface nodes at
+#: r ≈ 0.012 R₁); with the bound at 0.5 s at h/P ≈ 0.5 s. The equal-hardness pairs of campaign v1
+#: (default mesh, h/R 0.3) with P = 3000 and 0.1: all three reach h/R 0.3 (with 0.25 or with
+#: P = 1000 the E ratio 3 pair stopped at h/R 0.25, an element crushed; 0.05: at 0.29)
+APPROACH_DEPTH = 0.1
 #: trials of the two-body line search (:func:`~.solver.bracketed_line_search`): the bench pair
 #: (E₂ = 3E₁, R₂ = 2R₁, penalty 100, to h = 0.03 R₁) with 4 / 6 / 8 / 12: 103 / 82 / 78 / 78
 #: increments, 4 / 2 / 1 / 1 of them failed, 717 / 632 / 567 / 561 Newton iterations

@@ -169,6 +169,23 @@ def test_two_bodies_take_the_approach_scaled_penalty():
     assert c["F"][-1] == pytest.approx(F_stiff, rel=0.015)
 
 
+def test_two_bodies_sink_in_by_at_most_a_fraction_of_a_node_spacing():
+    """The approach-scaled penalty of two bodies is bounded (twobody.APPROACH_DEPTH): with
+    P = 1 (h/P = h, deeper than the pole's surface nodes are apart) the bodies still sink into
+    each other by no more than about APPROACH_DEPTH × the smallest surface node spacing."""
+    from spherecontact.fem import twobody
+    from spherecontact.fem.twobody import TwoBodySolver
+    from spherecontact.model.material import Material
+
+    m1, m2 = Material(E=200.0, nu=0.3, sigma_y=1.0), Material(E=600.0, nu=0.3, sigma_y=1.0)
+    solver = TwoBodySolver(m1, 1.0, m2, 2.0, options=SolverOptions(penalty=1.0, penalty_scale="approach"))
+    res = solver.run(2e-3)
+    bound = twobody.APPROACH_DEPTH * solver._surface_spacing
+    assert res.status == "converged" and res.curves["h_applied"][-1] > 5 * bound
+    sunk = res.curves["penetration"][-1]  # at the poles, where the pressure is highest
+    assert 0.5 * bound < sunk < 2.0 * bound
+
+
 def test_loading_steps_keep_the_strain_increment_from_the_first_one_on():
     """dh ≤ strain_increment · a of the increment before, and the first step ≤ strain_increment² R
     (its own Hertz radius √(R dh) obeys the same bound): a step of dh_first = 2e-4 R alone crosses

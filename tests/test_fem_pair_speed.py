@@ -1,0 +1,46 @@
+"""fem.pair_speed: the split comparison and the runs it builds from a stored pair."""
+
+import numpy as np
+import pytest
+
+from spherecontact.fem.design import load_campaign
+from spherecontact.fem.pair_speed import CASES, PENALTY, flat_kwargs, pair_kwargs, split_difference
+
+
+def _curves(h, split):
+    h = np.asarray(h, dtype=float)
+    return {"h": h, "h1": split * h}
+
+
+def test_split_difference_reads_a_planted_offset_within_the_window():
+    h = np.geomspace(1e-3, 0.3, 60)
+    stored = _curves(h, 0.6 + 0.1 * h)
+    new = _curves(np.geomspace(1e-3, 0.25, 90), 0.6 + 0.1 * np.geomspace(1e-3, 0.25, 90))
+    assert split_difference(stored, new, 0.01) == pytest.approx(0.0, abs=1e-12)
+    new["h1"] = new["h1"] + 0.03 * new["h"] * (new["h"] > 0.1)  # 3 points above from h = 0.1 on
+    assert split_difference(stored, new, 0.01) == pytest.approx(0.03, abs=1e-3)
+    # beyond the new run's end (0.25) and below h_min the stored curve is not read
+    stored["h1"][h > 0.26] = 0.0
+    stored["h1"][h < 0.009] = 0.0
+    assert split_difference(stored, new, 0.01) == pytest.approx(0.03, abs=1e-3)
+
+
+def test_unloading_increments_of_the_stored_run_are_left_out():
+    h = np.array([0.01, 0.02, 0.03, 0.025, 0.02, 0.03, 0.04])
+    stored = {"h": h, "h1": 0.5 * h, "branch": np.array([0, 0, 0, 1, 1, 2, 0])}
+    stored["h1"][3:6] = 0.9 * h[3:6]  # unloading and reloading far off: ignored
+    new = _curves(np.linspace(0.005, 0.05, 20), 0.5)
+    assert split_difference(stored, new, 0.01) == pytest.approx(0.0, abs=1e-12)
+
+
+def test_the_pairs_are_rerun_with_the_approach_scaled_penalty_and_body_1_alone():
+    cases = {c.name: c for c in load_campaign("data/campaign.toml").cases}
+    for name in CASES:
+        case = cases[name]
+        assert case.inputs["material"] == case.inputs["material2"] or case.inputs["radius2"] == 1.0
+        kw = pair_kwargs(case)
+        assert kw["options"].penalty == PENALTY and kw["options"].penalty_scale == "approach"
+        assert kw["unload_at"] is None and kw["radius2"] == case.inputs["radius2"]
+        flat = flat_kwargs(case)
+        assert "radius2" not in flat and "options" not in flat
+        assert flat["material"].sigma_y == kw["material2"].sigma_y  # equal hardness
