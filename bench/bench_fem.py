@@ -20,7 +20,8 @@ code path (nodal frames), and until 2026-11-26 it ran without line search at 5×
 time (149 s against 30 s) without any benchmark showing it. ``pair``: two plastic bodies of
 equal yield stress, E₂ = 3E₁ (E/σY 200 and 600), R₂ = 2R₁, two-pass penalty contact (P = 100),
 to h = 0.03 R₁, against body 1 alone on a rigid flat to the same approach (target: ≤ 3× its wall
-time).
+time); ``pair_approach``: the same pair with the penalty scaled with the approach (P = 3000;
+``fem.pair_speed``, whose ``make verify-pair-speed`` times the campaign's pairs to h/R 0.3).
 """
 
 from __future__ import annotations
@@ -80,20 +81,27 @@ def standard_run(linear_solver: str, edge_band: float = 0.0, unload_at=None, E: 
 PAIR_H = 0.03
 
 
-def pair_run() -> dict:
-    """The ``pair`` scene (module docstring) and body 1 alone on a flat to the same approach."""
+#: the ``pair_approach`` scene's penalty: k_N = P p_m/h (fem.pair_speed.PENALTY)
+PAIR_APPROACH = {"penalty": 3000.0, "penalty_scale": "approach"}
+
+
+def pair_run(**options) -> dict:
+    """The ``pair`` scene (module docstring; ``options``: its contact, default the two-pass
+    penalty 100 scaled with the modulus) and body 1 alone on a flat to the same approach."""
     body1 = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    options = options or {"penalty": 100.0}
     solver = TwoBodySolver(body1, 1.0, Material(E=600.0, nu=0.3, sigma_y=1.0), 2.0,
-                           options=SolverOptions(penalty=100.0))
+                           options=SolverOptions(**options))
     res = solver.run(PAIR_H)
     t = res.timings
     flat = IndentationSolver(body1, 1.0, RigidObstacle(math.inf)).run(PAIR_H).timings
-    return {"case": f"EPP E/sigma_Y 200 and 600, R2 = 2 R1, two-pass penalty 100, h = {PAIR_H} R1",
+    return {"case": f"EPP E/sigma_Y 200 and 600, R2 = 2 R1, two-pass penalty {options}, h = {PAIR_H} R1",
             "status": res.status, "n_dofs": solver.n_dofs, "wall_s": round(t["wall_s"], 2),
             "increments": t["increments"], "newton_iterations": t["newton_iterations"],
             "rejected_increments": t["rejected_increments"],
             "linear": linear_counts(t),
-            "F_end": float(res.F[-1]), "body1_flat_wall_s": round(flat["wall_s"], 2),
+            "F_end": float(res.F[-1]), "h_end": float(res.h[-1]),
+            "body1_flat_wall_s": round(flat["wall_s"], 2),
             "wall_over_body1_flat": round(t["wall_s"] / flat["wall_s"], 2),
             "target_wall_over_body1_flat": 3.0}
 
@@ -110,6 +118,7 @@ def main() -> dict:
     stiff = standard_run("cholesky", E=10000.0)
     rigid = standard_run("cholesky", indenter=2.0)
     pair = pair_run()
+    pair_approach = pair_run(**PAIR_APPROACH)
     per_cycle = (cycles["wall_s"] / after["wall_s"] - 1.0) / len(CYCLES_AT)
     return {
         "case": "EPP E/sigma_Y=200, nu=0.3, rigid flat, h/R=0.3, default mesh",
@@ -126,6 +135,7 @@ def main() -> dict:
         "rigid_sphere": {"case": "the standard run against a rigid sphere of radius 2R", **rigid,
                          "wall_over_flat": round(rigid["wall_s"] / after["wall_s"], 2)},
         "pair": pair,
+        "pair_approach": pair_approach,
         "speedup": round(before["wall_s"] / after["wall_s"], 2),
         "same_answer_F_a": [abs(after[k] / before[k] - 1) for k in ("F_end", "a_end")],
         "target_wall_s": 25.0,

@@ -310,8 +310,9 @@ def _with_pair_curves(result: RunResult, scene: str) -> RunResult:
     c.update(h=2.0 * half, h1=half, h2=half.copy(), dissipation_1=c["dissipation"].copy(),
              dissipation_2=c["dissipation"].copy(), eps_p_max_1=c["eps_p_max"].copy(),
              eps_p_max_2=c["eps_p_max"].copy(), interface_curvature=np.where(c["a"] > 0, 0.0, np.nan))
-    for k in ("work_external", "energy_elastic", "dissipation"):
-        c[k] = 2.0 * c[k]
+    for k in ("work_external", "energy_elastic", "dissipation", "h_applied", "penetration"):
+        if k in c:  # h_applied, penetration: penalty contact only
+            c[k] = 2.0 * c[k]
     cyc = result.cycles
     for k in ("h_max", "h_res", "work_in", "work_returned", "dissipation", "elastic_energy_change"):
         if k in cyc:

@@ -376,15 +376,14 @@ def bracketed_line_search(slope, s0: float, max_steps: int = 4):
     return below or tried
 
 
-def approach_stiffness(penalty: float, run: _RunState, h_new: float, E_prime: float, R_rel: float) -> float:
-    """k_N = penalty · p_m / h_new (``penalty_scale`` "approach"): the contact is pressed in by
-    about h/penalty at every approach. p_m is the last converged increment's F/(πa²), or Hertz's
-    4E′√(h/R*)/(3π) before contact (E′ the pair's contact modulus, R* its relative radius)."""
+def approach_pressure(run: _RunState, h_new: float, E_prime: float, R_rel: float) -> float:
+    """p_m of the penalty scaled with the approach (``penalty_scale`` "approach", k_N = P p_m/h,
+    the contact pressed in by about h/P at every approach): the last converged increment's
+    F/(πa²), or Hertz's 4E′√(h/R*)/(3π) before contact (E′ the pair's contact modulus, R* its
+    relative radius)."""
     if run.F > 0.0 and run.a > 0.0:
-        p_m = run.F / (np.pi * run.a**2)
-    else:
-        p_m = 4.0 * E_prime * np.sqrt(h_new / R_rel) / (3.0 * np.pi)
-    return penalty * p_m / h_new
+        return run.F / (np.pi * run.a**2)
+    return 4.0 * E_prime * np.sqrt(h_new / R_rel) / (3.0 * np.pi)
 
 
 def freeze_toggling(log: dict, plastic: np.ndarray, elastic: np.ndarray | None) -> np.ndarray | None:
@@ -1144,10 +1143,11 @@ class IndentationSolver(CycleLegs):
         (``segment_points``) and k_N = P p_m/h, a closing edge is pressed in over about h/P and
         takes its pressure gradually; the penetration is then the same fraction 1/P of the
         approach at every h, and the body's own shortening (curve ``h``) excludes it
-        (:func:`approach_stiffness`).
+        (:func:`approach_pressure`).
         """
         R_rel = 1.0 / (1.0 / self.radius + 1.0 / self.obstacle.radius)
-        self.k_penalty = approach_stiffness(self.options.penalty, run, h_new, self._pair_modulus(), R_rel)
+        p_m = approach_pressure(run, h_new, self._pair_modulus(), R_rel)
+        self.k_penalty = self.options.penalty * p_m / h_new
         if self.segments is not None:
             self.segments.k_n = self.k_penalty
 

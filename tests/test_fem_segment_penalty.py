@@ -139,6 +139,24 @@ def test_approach_scaled_penalty_presses_in_about_h_over_P_and_h_is_the_body_sho
     assert c["F"][-1] == pytest.approx(F_exact, rel=0.015)  # within the exact run's node steps
 
 
+def test_equal_pair_by_symmetry_doubles_the_applied_approach_and_the_penetration():
+    """The equal pair runs as one hemisphere on the mid-plane: every approach of the pair is twice
+    the hemisphere's, the penalty contact's h_applied and penetration included."""
+    from spherecontact.fem.io import run_indentation
+    from spherecontact.model.material import Material
+
+    m = Material(E=1000.0, nu=0.3, sigma_y=1.0)
+    res = run_indentation(m, 1.0, 2e-3, radius2=1.0, material2=m,
+                          options=SolverOptions(penalty=300.0, segment_points=8, penalty_scale="approach"))
+    c = res.curves
+    assert res.inputs["scene"] == "equal_pair_symmetry" and res.status == "converged"
+    assert c["h_applied"][-1] == pytest.approx(2e-3, rel=1e-12)
+    late = c["h_applied"] > 1e-3
+    sunk = (c["h_applied"] - c["h"])[late]  # at the pole, against the largest penetration
+    assert np.allclose(sunk, c["penetration"][late], rtol=0.5, atol=0)
+    assert np.all(c["penetration"][late] > 0.2 * 1e-3 / 300.0)
+
+
 def test_penalty_scale_is_checked():
     with pytest.raises(ValueError, match="penalty_scale must be one of"):
         SolverOptions(penalty=1.0, penalty_scale="pressure").validate()
