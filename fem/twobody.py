@@ -93,9 +93,10 @@ APPROACH_PAIR_TOL = 1e-5
 #: wavy at that scale has no unique closest point, and Newton cycles. Pair E₂ = 3E₁, R₂ = 2R₁
 #: (band 0.03, s = 2.7e-4 R₁ near the pole), with h/P alone: stalled at h/P = 2.2e-4 / 1.7e-4 /
 #: 1.5e-4 R₁ (P = 300 / 500 / 1000; residuals cycling at 1e-6 … 1e-3 on surface nodes at
-#: r ≈ 0.012 R₁); with the bound at 0.5 s at h/P ≈ 0.5 s. The equal-hardness pairs of campaign v1
-#: (default mesh, h/R 0.3) with P = 3000 and 0.1: all three reach h/R 0.3 (with 0.25 or with
-#: P = 1000 the E ratio 3 pair stopped at h/R 0.25, an element crushed; 0.05: at 0.29)
+#: r ≈ 0.012 R₁); with the bound at 0.5 (band floor 0.0015, s = 8e-4 R₁) at h/P ≈ 0.6 s. The
+#: equal-hardness pairs of campaign v1 (default mesh, h/R 0.3) with P = 3000 and 0.1: all three
+#: reach h/R 0.3 (with P = 1000 the E ratio 3 pair stopped at h/R 0.25, an element crushed, and
+#: at 0.29 with the bound at 0.05)
 APPROACH_DEPTH = 0.1
 #: trials of the two-body line search (:func:`~.solver.bracketed_line_search`): the bench pair
 #: (E₂ = 3E₁, R₂ = 2R₁, penalty 100, to h = 0.03 R₁) with 4 / 6 / 8 / 12: 103 / 82 / 78 / 78
