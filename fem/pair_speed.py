@@ -10,7 +10,9 @@ from its stored inputs with that penalty (no cycles) and body 1 alone on a rigid
 solver's defaults (exact contact), one run at a time, and compares the pair with its stored
 curve (``reproduce.compare_loading``: systematic and largest difference of F and a at the stored
 approaches h/R ≥ 0.01, beside both curves' FE scatter; the split h₁/h, largest difference in
-percentage points).
+percentage points). Against an independent reference: the elastic dissimilar pair of
+``make verify-pair`` (E₂/E₁ = 3, R₂ = 2R₁, ν 0.3 / 0.2, 2× mesh) with the same penalty, F against
+the reference contact radius vs Hertz with E*, R* and h₁/h₂ vs E′₂/E′₁ (its limits: 1 % and 2 %).
 
 ``python -m spherecontact.fem.pair_speed --out reports/fem`` → ``approach_pairs.json`` (~4 min).
 """
@@ -30,6 +32,8 @@ from ..data import Database
 from .design import load_campaign
 from .io import run_indentation
 from .reproduce import compare_loading
+from .solver import SolverOptions
+from .verification_pair import HERTZ_PAIR, _hertz
 
 #: the equal-hardness pairs of campaign v1 (penalty contact, default mesh, h/R 0.3)
 CASES = ("two-pp-E200-nu0.3-vs-R2", "two-pp-E200-nu0.3-vs-R4", "two-pp-E200-nu0.3-vs-E600")
@@ -82,6 +86,15 @@ def check_case(case, stored, flat_wall: float, penalty: float = PENALTY) -> dict
             "vs_stored": cmp, "split_max": split_difference(stored.curves, res.curves, 0.01 * R)}
 
 
+def hertz_check(penalty: float = PENALTY) -> dict:
+    """The elastic pair of ``make verify-pair``'s Hertz check (2× mesh) with the approach-scaled
+    penalty, and its figures (``verification_pair._hertz``)."""
+    options = SolverOptions(penalty=penalty, penalty_scale="approach")
+    res, wall = _timed({**HERTZ_PAIR, "density": 2.0, "options": options})
+    run = {"curves": res.curves, "wall_s": wall, "n_dofs": res.inputs["n_dofs"]}
+    return {"status": res.status, **_hertz(run)}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--db", default="data/reference.h5")
@@ -108,9 +121,13 @@ def main(argv: list[str] | None = None) -> int:
               f"F {100 * F['systematic']:+.2f} % (max {100 * F['max']:.2f}, scatter stored "
               f"{100 * F['stored_scatter']:.2f} / new {100 * F['new_scatter']:.2f}), a "
               f"{100 * a['systematic']:+.2f} %, split {100 * row['split_max']:.2f} points", flush=True)
+    hz = hertz_check(args.penalty)
+    print(f"elastic pair vs Hertz (E*, R*): F against a within {hz['F_vs_a_max_pct']:.2f} % (mean "
+          f"{hz['F_vs_a_mean_pct']:+.2f} %), h1/h2 within {hz['h1_over_h2_dev_pct_small_h']:.2f} % at "
+          f"a/R <= 0.02 ({hz['h1_over_h2_dev_pct_all']:.2f} % over the run)", flush=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "approach_pairs.json").write_text(json.dumps(rows, indent=1) + "\n")
+    (out / "approach_pairs.json").write_text(json.dumps({"pairs": rows, "hertz": hz}, indent=1) + "\n")
     return 0
 
 
