@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 
 from spherecontact.fem.contact import RigidObstacle
+from spherecontact.fem.pair_speed import PENALTY as PAIR_SPEED_PENALTY
 from spherecontact.fem.solver import IndentationSolver, SolverOptions
 from spherecontact.fem.twobody import TwoBodySolver
 from spherecontact.model import Material
@@ -81,8 +82,8 @@ def standard_run(linear_solver: str, edge_band: float = 0.0, unload_at=None, E: 
 PAIR_H = 0.03
 
 
-#: the ``pair_approach`` scene's penalty: k_N = P p_m/h (fem.pair_speed.PENALTY)
-PAIR_APPROACH = {"penalty": 3000.0, "penalty_scale": "approach"}
+#: the ``pair_approach`` scene's penalty: k_N = P p_m/h, P as ``make verify-pair-speed`` runs it
+PAIR_APPROACH = {"penalty": PAIR_SPEED_PENALTY, "penalty_scale": "approach"}
 
 
 def pair_run(**options) -> dict:
