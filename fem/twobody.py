@@ -108,7 +108,7 @@ OFF_CURVE = 0.5
 #: segment-integrated two-body contact (``segment_points`` > 0) is smooth and right at small
 #: approaches but not at large ones. On campaign v1's pair E₂ = 3E₁ (P = 3000, band 0.03, 3 Gauss
 #: points per edge), against the nodal two-pass contact:
-#: - the split h₁/h is 0.809 against 0.707 at h/R 0.05, and 0.950 against 0.522 at 0.3 (the stored
+#: - the split h₁/h is 0.808 against 0.708 at h/R 0.05, and 0.950 against 0.522 at 0.3 (the stored
 #:   run: about 0.55);
 #: - the pressure alternates by a factor 2–3 from edge to edge.
 #: The pass that presses the stiffer body's Gauss points on the softer one does it: alone it gives
