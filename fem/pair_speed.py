@@ -33,7 +33,7 @@ from .design import load_campaign
 from .io import run_indentation
 from .reproduce import compare_loading
 from .solver import SolverOptions
-from .verification_pair import HERTZ_PAIR, _hertz
+from .verification_pair import HERTZ_PAIR, hertz_figures
 
 #: the equal-hardness pairs of campaign v1 (penalty contact, default mesh, h/R 0.3)
 CASES = ("two-pp-E200-nu0.3-vs-R2", "two-pp-E200-nu0.3-vs-R4", "two-pp-E200-nu0.3-vs-E600")
@@ -88,11 +88,11 @@ def check_case(case, stored, flat_wall: float, penalty: float = PENALTY) -> dict
 
 def hertz_check(penalty: float = PENALTY) -> dict:
     """The elastic pair of ``make verify-pair``'s Hertz check (2× mesh) with the approach-scaled
-    penalty, and its figures (``verification_pair._hertz``)."""
+    penalty, and its figures (``verification_pair.hertz_figures``)."""
     options = SolverOptions(penalty=penalty, penalty_scale="approach")
     res, wall = _timed({**HERTZ_PAIR, "density": 2.0, "options": options})
     run = {"curves": res.curves, "wall_s": wall, "n_dofs": res.inputs["n_dofs"]}
-    return {"status": res.status, **_hertz(run)}
+    return {"status": res.status, **hertz_figures(run)}
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -148,7 +148,7 @@ def _equal_pair(two: dict, flat: dict) -> dict:
             "dofs_two_body": two["n_dofs"], "dofs_flat": flat["n_dofs"]}
 
 
-def _hertz(hz: dict) -> dict:
+def hertz_figures(hz: dict) -> dict:
     """F against the reference contact radius vs Hertz with E*, R* over a/R₁ 0.01–0.05, and
     h₁/h₂ against E'₂/E'₁ (at a/R₁ ≤ 0.02 and over the whole run), of the elastic pair."""
     m1, m2 = HERTZ_PAIR["material"], HERTZ_PAIR["material2"]
@@ -181,9 +181,9 @@ def evaluate(runs: dict, quick: bool) -> dict:
     if "hard_two_body" in runs:  # exact one-pass contact, a hardening equal pair
         fig["hard"] = _equal_pair(runs["hard_two_body"], runs["hard_flat"])
     # elastic dissimilar pair against Hertz with E*, R*: on the 2× mesh, and at density 1 (info)
-    fig["hertz"] = _hertz(runs["hertz_d2"])
+    fig["hertz"] = hertz_figures(runs["hertz_d2"])
     if "hertz" in runs:
-        fig["hertz_density1"] = _hertz(runs["hertz"])
+        fig["hertz_density1"] = hertz_figures(runs["hertz"])
     # stiff elastic body 2 against the rigid-sphere scene. F(h) of both scenes ripples by a few %
     # as single nodes close at small h; the method difference is measured on F smoothed like a
     # (local power-law fit over 7 increments, contact.smooth_contact_radius), raw figures kept.
