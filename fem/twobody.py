@@ -112,7 +112,7 @@ OFF_CURVE = 0.5
 #: - the split h₁/h is 0.808 against 0.708 at h/R 0.05, and 0.950 against 0.522 at 0.3 (the stored
 #:   nodal run: 0.54);
 #: - the Gauss-point pressure alternates by a factor 2–3 from edge to edge;
-#: - nodal two-pass contact leaves a corner/midside sawtooth of meshing teeth on both surfaces
+#: - nodal two-pass contact leaves a corner/midside sawtooth on both surfaces (``pair_surface.py``)
 #:   (rms second difference 2.7e-3 R at h/R 0.1, against 1e-4 R here).
 #: Below h/R 0.02 the curves agree with nodal contact within 0.5 % in F, and with Hertz within
 #: 0.49 % (``make verify-pair``'s elastic pair, 2× mesh).
