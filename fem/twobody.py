@@ -259,19 +259,25 @@ class ContactPass:
         d2 = (xs[0][:, None] - xm[0][None]) ** 2 + (xs[1][:, None] - xm[1][None]) ** 2
         k = np.argmin(d2, axis=1)
         last = self.ctrl_nodes.shape[1] - 1
-        best, best_excess = None, None
-        for seg in (np.clip(k - 1, 0, last), np.clip(k, 0, last)):  # the interval holding t
-            coords = self._coords(xs, u, seg)
-            gap, grad, t, normal = gap_gradient(coords, self.side)
-            here = Kinematics(seg, coords, gap, grad, normal)
-            excess = np.maximum(np.maximum(-t, t - 1.0), 0.0)
-            if best is None:
-                best, best_excess = here, excess
-            else:
-                better = excess < best_excess
-                best = Kinematics(*(np.where(better, new, old) for new, old in zip(here, best, strict=True)))
-                best_excess = np.minimum(excess, best_excess)
-        return best, best_excess
+        # the interval holding t: the one ending at the nearest master node, else the one starting
+        # there (projected only for the points whose t fell outside the first)
+        best, excess = self._projected(xs, u, np.clip(k - 1, 0, last))
+        redo = np.flatnonzero(excess > 0.0)
+        if redo.size:
+            here, excess_here = self._projected(xs[:, redo], u, np.clip(k[redo], 0, last))
+            better = excess_here < excess[redo]
+            rows = redo[better]
+            for old, new in zip(best, here, strict=True):
+                old[..., rows] = new[..., better]
+            excess[rows] = excess_here[better]
+        return best, excess
+
+    def _projected(self, xs, u, seg) -> tuple[Kinematics, np.ndarray]:
+        """Kinematics of the points ``xs`` projected on the master intervals ``seg``, and how far
+        outside [0, 1] each projection's t lies."""
+        coords = self._coords(xs, u, seg)
+        gap, grad, t, normal = gap_gradient(coords, self.side)
+        return Kinematics(seg, coords, gap, grad, normal), np.maximum(np.maximum(-t, t - 1.0), 0.0)
 
     def _coords(self, xs, u, seg):
         """(10, n): slave positions ``xs`` and the control points of intervals ``seg``."""
@@ -289,13 +295,13 @@ class ContactPass:
         ``seg``: the k slave nodes of each point, then the master's four control points."""
         s, m = self.slave, self.master
         k = self.point_nodes.shape[0]
-        nodes = list(self.point_nodes[:, rows]) + [self.ctrl_nodes[j, seg] for j in range(4)]
-        rsigns = [np.ones(rows.size)] * k + [self.ctrl_rsign[j, seg] for j in range(4)]
-        bodies = [s] * k + [m] * 4
-        dofs = np.concatenate([np.stack([b.offset + 2 * nd, b.offset + 2 * nd + 1])
-                               for b, nd in zip(bodies, nodes, strict=True)])
-        signs = np.concatenate([np.stack([rs, np.full(rows.size, b.zsign)])
-                                for b, rs in zip(bodies, rsigns, strict=True)])
+        nodes = np.concatenate([self.point_nodes[:, rows], self.ctrl_nodes[:, seg]])  # (k + 4, n)
+        offset = np.array([s.offset] * k + [m.offset] * 4)[:, None]
+        zsign = np.array([s.zsign] * k + [m.zsign] * 4)[:, None]
+        r_dof = offset + 2 * nodes
+        dofs = np.stack([r_dof, r_dof + 1], axis=1).reshape(-1, rows.size)  # r, z of each node
+        rsign = np.concatenate([np.ones((k, rows.size)), self.ctrl_rsign[:, seg]])
+        signs = np.stack([rsign, np.broadcast_to(zsign, rsign.shape)], axis=1).reshape(-1, rows.size)
         return dofs, signs
 
     def constraints(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
