@@ -299,9 +299,9 @@ class ContactPass:
         offset = np.array([s.offset] * k + [m.offset] * 4)[:, None]
         zsign = np.array([s.zsign] * k + [m.zsign] * 4)[:, None]
         r_dof = offset + 2 * nodes
-        dofs = np.stack([r_dof, r_dof + 1], axis=1).reshape(-1, rows.size)  # r, z of each node
+        dofs = np.stack([r_dof, r_dof + 1], axis=1).reshape(2 * (k + 4), rows.size)  # r, z of each node
         rsign = np.concatenate([np.ones((k, rows.size)), self.ctrl_rsign[:, seg]])
-        signs = np.stack([rsign, np.broadcast_to(zsign, rsign.shape)], axis=1).reshape(-1, rows.size)
+        signs = np.stack([rsign, np.broadcast_to(zsign, rsign.shape)], axis=1).reshape(2 * (k + 4), rows.size)
         return dofs, signs
 
     def constraints(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):

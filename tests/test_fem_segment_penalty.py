@@ -315,3 +315,18 @@ def test_segment_contact_carries_the_load_of_nodal_contact_and_keeps_hertz():
     sel = a >= 0.02
     assert sel.sum() >= 5
     assert np.abs(seg.F[sel] / (4 * Es * a[sel] ** 3 / (3 * 2.0 / 3.0)) - 1).max() < 0.015
+
+
+def test_pair_dofs_of_no_points_are_empty_blocks():
+    """No penetrating point (a pair opening on unloading): empty dof and sign blocks of the right
+    height, for nodal and for Gauss-point passes."""
+    from spherecontact.fem.twobody import TwoBodySolver
+    from spherecontact.model.material import Material
+
+    m = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    nodal = TwoBodySolver(m, 1.0, m, 2.0, options=SolverOptions(penalty=100.0))
+    gauss, _ = _pressed_pair(3)
+    none = np.array([], dtype=int)
+    for p in nodal.passes + gauss.passes:
+        dofs, signs = p._pair_dofs(none, none)
+        assert dofs.shape == signs.shape == (2 * (p.point_nodes.shape[0] + 4), 0)
