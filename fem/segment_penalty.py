@@ -25,6 +25,20 @@ import numpy as np
 from .contact import RigidObstacle
 
 
+def edge_gauss_points(X_arc: np.ndarray, n_points: int):
+    """Gauss points of the quadratic edges of an arc (corner and midside nodes alternating from
+    the pole, n odd): edges (e, 3) as arc positions, shape functions N (3, q) at the points, their
+    reference area weights w_q = 2π R(ξ_q) |∂X/∂ξ| w_ξ (e, q) and reference radii R(ξ_q) (e, q)."""
+    edges = np.arange(0, X_arc.shape[1] - 2, 2)[:, None] + np.arange(3)[None, :]
+    xi, w = np.polynomial.legendre.leggauss(n_points)
+    N = np.stack([xi * (xi - 1) / 2, 1 - xi**2, xi * (xi + 1) / 2])
+    dN = np.stack([xi - 0.5, -2 * xi, xi + 0.5])
+    Xe = X_arc[:, edges]  # (2, e, 3)
+    Xq = np.einsum("cea,aq->ceq", Xe, N)
+    dX = np.einsum("cea,aq->ceq", Xe, dN)
+    return edges, N, 2 * np.pi * Xq[0] * np.hypot(dX[0], dX[1]) * w, Xq[0]
+
+
 class SegmentPenalty:
     """Penalty contact of the quadratic arc edges against a rigid obstacle.
 
@@ -43,15 +57,7 @@ class SegmentPenalty:
         if n < 3 or n % 2 == 0:
             raise ValueError("the arc needs an odd number of nodes (quadratic edges)")
         self.k_n = float(k_n)
-        self.edges = np.arange(0, n - 2, 2)[:, None] + np.arange(3)[None, :]  # (n_edges, 3)
-        xi, w = np.polynomial.legendre.leggauss(n_points)
-        self.N = np.stack([xi * (xi - 1) / 2, 1 - xi**2, xi * (xi + 1) / 2])  # (3, q)
-        dN = np.stack([xi - 0.5, -2 * xi, xi + 0.5])
-        Xe = X_arc[:, self.edges]  # (2, e, 3)
-        Xq = np.einsum("cea,aq->ceq", Xe, self.N)
-        dX = np.einsum("cea,aq->ceq", Xe, dN)
-        self.R_q = Xq[0]  # (e, q) reference radius of the points
-        self.weights = 2 * np.pi * Xq[0] * np.hypot(dX[0], dX[1]) * w  # (e, q)
+        self.edges, self.N, self.weights, self.R_q = edge_gauss_points(X_arc, n_points)
         self.n_nodes = n
 
     def points(self, x_arc: np.ndarray) -> np.ndarray:

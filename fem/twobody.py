@@ -40,6 +40,7 @@ from .contact import contact_edge, surface_areas
 from .linsolve import ConstrainedPattern, SymmetricSolver
 from .mesh import REVERSED, build_mesh
 from .plasticity import PlasticState, stress_update, tangent
+from .segment_penalty import edge_gauss_points
 from .segments import gap_gradient, gap_hessian
 from .solver import (
     ROUNDOFF,
@@ -400,18 +401,11 @@ class SegmentContactPass(ContactPass):
     def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 4):
         super().__init__(slave, master, n_dofs, weight)
         arc = slave.hmesh.surface
-        edges = np.arange(0, arc.size - 3, 2)[:, None] + np.arange(3)[None, :]  # all but the equator's
-        xi, w = np.polynomial.legendre.leggauss(n_gauss)
-        N = np.stack([xi * (xi - 1) / 2, 1 - xi**2, xi * (xi + 1) / 2])  # (3, q)
-        dN = np.stack([xi - 0.5, -2 * xi, xi + 0.5])
-        Xe = slave.hmesh.X[:, arc[edges]]  # (2, e, 3)
-        Xq = np.einsum("cea,aq->ceq", Xe, N)
-        dX = np.einsum("cea,aq->ceq", Xe, dN)
-        n_e = edges.shape[0]
+        edges, N, area, r0 = edge_gauss_points(slave.hmesh.X[:, arc], n_gauss)
+        edges, area, r0 = edges[:-1], area[:-1], r0[:-1]  # all edges but the equator's
         self.point_nodes = np.repeat(arc[edges].T, n_gauss, axis=1)  # (3, e·q), edge by edge
-        self.point_weights = np.tile(N, (1, n_e))
-        self.area0 = (2 * np.pi * Xq[0] * np.hypot(dX[0], dX[1]) * w).ravel()
-        self.r0 = Xq[0].ravel()
+        self.point_weights = np.tile(N, (1, edges.shape[0]))
+        self.area0, self.r0 = area.ravel(), r0.ravel()
 
     def kinematics(self, u: np.ndarray) -> Kinematics:
         """:meth:`ContactPass.kinematics`; a point whose closest point lies beyond the master's
@@ -765,12 +759,13 @@ class TwoBodySolver(CycleLegs):
             t2 = time.perf_counter()
             kins = kins or [p.kinematics(u) for p in self.passes]
             r = f.copy()
-            pens, lams = [], []
+            pens, lams, forces = [], [], []
             for p, kin in zip(self.passes, kins, strict=True):
                 pen, lam_p, Gt_lam = p.penalty_force(kin, self.k_penalty)
                 r -= Gt_lam
                 pens.append(pen)
                 lams.append(lam_p)
+                forces.append(Gt_lam)
             changed = prev is None or any(not np.array_equal(a, b) for a, b in zip(pens, prev, strict=True))
             log["changes"] += prev is not None and changed
             prev = pens
@@ -787,7 +782,7 @@ class TwoBodySolver(CycleLegs):
                 self.plastic_frozen_increments += log.get("plastic_frozen", False)
                 if isinstance(p0, SegmentContactPass):
                     self._point_gap = kin0.gap
-                    act, lam_n, gap_n, normal_n = self._nodal_reactions(u, kin0, lams[0])
+                    act, lam_n, gap_n, normal_n = self._nodal_reactions(u, forces[0])
                     return (u, per_body, f, act, lam_n, gap_n, normal_n, it, log, F)
                 return (u, per_body, f, pens[0], lams[0] / p0.weight, kin0.gap, kin0.normal, it, log, F)
             self.timers["contact"] += time.perf_counter() - t2
@@ -799,15 +794,12 @@ class TwoBodySolver(CycleLegs):
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {log['res'][-1]:.2e})")
 
-    def _nodal_reactions(self, u, kin0, lam0):
-        """Segment-integrated contact read at the slave's surface nodes (the first pass): the
-        nodes' normal reactions (the pass's Gᵀλ on each node along the master normal there, per
-        unit pass weight), positive where a node carries pressure, and their gap and normal.
+    def _nodal_reactions(self, u, force):
+        """Segment-integrated contact read at the slave's surface nodes: the nodes' normal
+        reactions (``force``, the first pass's Gᵀλ, on each node along the master normal there,
+        per unit pass weight), positive where a node carries pressure, and their gap and normal.
         Returns (carrying nodes, reactions, gap, normal) as nodal contact does."""
         p0 = self.passes[0]
-        rows = np.flatnonzero(lam0 > 0.0)
-        dofs, signs = p0._dofs_and_signs(kin0.seg, rows)
-        force = p0._force(dofs, p0._expand(kin0.grad[:, rows], rows) * signs, lam0[rows])
         kin = self.contact.kinematics(u)
         s, nodes = self.slave, self.candidates
         fr, fz = force[s.offset + 2 * nodes], s.zsign * force[s.offset + 2 * nodes + 1]
