@@ -23,7 +23,7 @@ from .assembly import ELEMENTS
 from .io import SCENES, check_inputs, run_indentation, write_run
 from .linsolve import METHODS as LINEAR_METHODS
 from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN
-from .solver import PENALTY_SCALES, SolverOptions
+from .solver import PENALTY_SCALES, SEGMENT_SCHEMES, SolverOptions
 
 __all__ = ["register", "run_command", "render_command", "read_flow_table", "material_from_args",
            "options_from_args", "EXIT_STOPPED"]
@@ -108,13 +108,13 @@ def material2_from_args(args: argparse.Namespace, material: Material) -> Materia
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
     """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
     --strain-increment, --max-wall-s, --no-line-search, --penalty, --segment-points,
-    --penalty-scale and --linear-solver."""
+    --segment-scheme, --penalty-scale and --linear-solver."""
     return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
                          max_iterations=args.max_iterations, tol=args.tol,
                          strain_increment=args.strain_increment, max_wall_s=args.max_wall_s,
                          line_search=not args.no_line_search, penalty=args.penalty,
-                         segment_points=args.segment_points, penalty_scale=args.penalty_scale,
-                         linear_solver=args.linear_solver)
+                         segment_points=args.segment_points, segment_scheme=args.segment_scheme,
+                         penalty_scale=args.penalty_scale, linear_solver=args.linear_solver)
 
 
 def _check_output(out) -> Path:
@@ -296,6 +296,10 @@ def _add_numerics(add) -> None:
     add(grp, "--segment-points", type=int, default=0,
         help="with --penalty (one body on a rigid flat or sphere): integrate the contact pressure "
              "at this many Gauss points per surface edge, 1-64 (default 0: at the nodes)")
+    add(grp, "--segment-scheme", choices=SEGMENT_SCHEMES, default=_DEFAULTS.segment_scheme,
+        help="two bodies with --segment-points: 'points' (default; each Gauss point its own "
+             "penalty, both bodies in turn) or 'mortar' (one pass of the softer body's weighted "
+             "nodal gaps, --segment-points Gauss points per half edge)")
     add(grp, "--penalty-scale", choices=PENALTY_SCALES, default=_DEFAULTS.penalty_scale,
         help="with --penalty: 'modulus' (default), stiffness penalty * E / (pole element "
              "length); 'approach', stiffness penalty * p_m / h, so the obstacle (or the other "

@@ -25,12 +25,16 @@ import numpy as np
 from .contact import RigidObstacle
 
 
-def edge_gauss_points(X_arc: np.ndarray, n_points: int):
+def edge_gauss_points(X_arc: np.ndarray, n_points: int, halves: bool = False):
     """Gauss points of the quadratic edges of an arc (corner and midside nodes alternating from
     the pole, n odd): edges (e, 3) as arc positions, shape functions N (3, q) at the points, their
-    reference area weights w_q = 2π R(ξ_q) |∂X/∂ξ| w_ξ (e, q) and reference radii R(ξ_q) (e, q)."""
+    reference area weights w_q = 2π R(ξ_q) |∂X/∂ξ| w_ξ (e, q) and reference radii R(ξ_q) (e, q).
+    ``halves``: ``n_points`` on each half of the edge (ξ < 0 first, then ξ > 0), 2 n_points in all,
+    so that functions with a kink at the midside node integrate exactly."""
     edges = np.arange(0, X_arc.shape[1] - 2, 2)[:, None] + np.arange(3)[None, :]
     xi, w = np.polynomial.legendre.leggauss(n_points)
+    if halves:
+        xi, w = np.concatenate([(xi - 1) / 2, (xi + 1) / 2]), np.concatenate([w, w]) / 2
     N = np.stack([xi * (xi - 1) / 2, 1 - xi**2, xi * (xi + 1) / 2])
     dN = np.stack([xi - 0.5, -2 * xi, xi + 0.5])
     Xe = X_arc[:, edges]  # (2, e, 3)

@@ -78,6 +78,8 @@ class IncrementFailed(RuntimeError):
 
 #: ways of setting the penalty stiffness (SolverOptions.penalty_scale)
 PENALTY_SCALES = ("modulus", "approach")
+#: how two bodies integrate the segment penalty (SolverOptions.segment_scheme)
+SEGMENT_SCHEMES = ("points", "mortar")
 
 
 #: Newton's default tolerance, ‖free residual‖∞ ≤ NEWTON_TOL · largest reaction. 1e-4 stops each
@@ -123,6 +125,11 @@ class SolverOptions:
     #: 0: penalty at the nodes; n > 0: penalty pressure integrated at n Gauss points per surface
     #: edge (segment_penalty.py), which needs ``penalty``
     segment_points: int = 0
+    #: two bodies with ``segment_points``: "points", each Gauss point its own penalty, both
+    #: bodies' points in turn (two passes); "mortar", one pass of the softer body's weighted gaps,
+    #: ``segment_points`` Gauss points on each half edge (twobody.MortarContactPass). One body
+    #: against a rigid obstacle takes "points" only
+    segment_scheme: str = "points"
     #: how ``penalty`` sets k_N: "modulus", k_N = penalty · E / ℓ; "approach",
     #: k_N = penalty · p_m / h (p_m = F/πa² of the last converged loading increment, Hertz's
     #: before contact), so the obstacle is pressed in by about h / penalty at every approach and
@@ -161,6 +168,10 @@ class SolverOptions:
                              f"got {self.segment_points!r}")
         if self.segment_points and self.penalty is None:
             raise ValueError("segment_points > 0 needs penalty contact: set penalty (> 0) as well")
+        if self.segment_scheme not in SEGMENT_SCHEMES:
+            raise ValueError(f"segment_scheme must be one of {SEGMENT_SCHEMES}, got {self.segment_scheme!r}")
+        if self.segment_scheme == "mortar" and not self.segment_points:
+            raise ValueError("segment_scheme 'mortar' needs segment_points > 0 (Gauss points per half edge)")
         if self.penalty_scale not in PENALTY_SCALES:
             raise ValueError(f"penalty_scale must be one of {PENALTY_SCALES}, got {self.penalty_scale!r}")
         if self.penalty_scale == "approach" and self.penalty is None:
@@ -867,6 +878,9 @@ class IndentationSolver(CycleLegs):
             self.k_penalty = self.options.penalty * material.E / pole_edge
             self.area0 = surface_areas(x_arc)[:-1]
         self.segments = None
+        if self.options.segment_scheme != "points":
+            raise ValueError(f"segment_scheme {self.options.segment_scheme!r} is for two deformable bodies; "
+                             "a rigid obstacle takes 'points'")
         if self.options.segment_points:
             self.segments = SegmentPenalty(self.X[:, self.arc], self.k_penalty, self.options.segment_points)
             na = self.arc[self.segments.edges]  # (e, 3) nodes of each edge

@@ -433,6 +433,69 @@ class SegmentContactPass(ContactPass):
         return np.einsum("ain,ijn,bjn->abn", J, H, J, optimize=True)
 
 
+class MortarContactPass(SegmentContactPass):
+    """Penalty mortar contact (Puso & Laursen 2004; Wriggers 2006 §9.3, in the penalty form): the
+    gap is weighed over the slave's edges against a weight function ψ_j of each slave node,
+
+        g̃_j = ∫ ψ_j g dA / A_j,   A_j = ∫ ψ_j dA,   λ_j = w k_N A_j ⟨−g̃_j⟩,
+
+    one pressure unknown per slave node (as nodal contact, so a quadratic edge does not lock) but
+    the gap sampled between the nodes (as the Gauss points, so the surfaces need not interlock).
+    ψ_j is the piecewise-linear hat of node j on the edges split at their midside nodes: the
+    quadratic shape functions would not do, their corner ones are negative over part of the edge
+    and on an axisymmetric surface the pole node's ∫ N dA is zero. The integrals are sums over
+    ``n_gauss`` Gauss points on each half edge with their reference areas A_q, so g̃ = M g with
+    the fixed matrix M_jq = ψ_j(ξ_q) A_q / A_j; the points carry Λ_q = Σ_j M_jq λ_j ≥ 0, and
+
+        Gᵀλ = Σ_q Λ_q ∂g_q,   ∂(Gᵀλ)/∂u = −w k_N G̃ᵀ diag(A_j) G̃ + Σ_q Λ_q ∂²g_q,   G̃ = M G.
+    """
+
+    def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 2):
+        ContactPass.__init__(self, slave, master, n_dofs, weight)
+        arc = slave.hmesh.surface
+        edges, N, area, r0 = edge_gauss_points(slave.hmesh.X[:, arc], n_gauss, halves=True)
+        edges, area, r0 = edges[:-1], area[:-1], r0[:-1]  # all edges but the equator's
+        q = N.shape[1]
+        self.point_nodes = np.repeat(arc[edges].T, q, axis=1)  # (3, e·q), edge by edge
+        self.point_weights = np.tile(N, (1, edges.shape[0]))
+        self.area0, self.r0 = area.ravel(), r0.ravel()
+        xi = N[2] - N[0]
+        hat = np.stack([np.maximum(-xi, 0.0), 1.0 - np.abs(xi), np.maximum(xi, 0.0)])
+        pos = np.repeat(edges.T, q, axis=1)  # (3, points): arc position of each node
+        cols = np.broadcast_to(np.arange(pos.shape[1]), pos.shape)
+        raw = sp.csr_matrix(((np.tile(hat, (1, edges.shape[0])) * self.area0).ravel(),
+                             (pos.ravel(), cols.ravel())), shape=(self.candidates.size, pos.shape[1]))
+        raw.eliminate_zeros()
+        #: reference area of each slave node's hat (0 where no edge point reaches it)
+        self.node_area = np.asarray(raw.sum(axis=1)).ravel()
+        scale = np.divide(1.0, self.node_area, out=np.zeros_like(self.node_area), where=self.node_area > 0)
+        self.mortar = (sp.diags(scale) @ raw).tocsr()
+        self.mortar_t = self.mortar.T.tocsr()
+
+    def node_gap(self, kin: Kinematics) -> np.ndarray:
+        """Weighted gap g̃_j of every slave node (+inf where no edge point reaches it)."""
+        return np.where(self.node_area > 0, self.mortar @ kin.gap, np.inf)
+
+    def penalty_force(self, kin: Kinematics, k_n: float):
+        """Points carrying pressure (Λ_q > 0), their Λ_q, and Gᵀλ."""
+        lam_node = self.weight * k_n * self.node_area * np.maximum(-self.node_gap(kin), 0.0)
+        lam = self.mortar_t @ lam_node
+        pen = lam > 0.0
+        rows = np.flatnonzero(pen)
+        dofs, signs = self._dofs_and_signs(kin.seg, rows)
+        return pen, lam, self._force(dofs, self._expand(kin.grad[:, rows], rows) * signs, lam[rows])
+
+    def penalty_tangent(self, kin: Kinematics, k_n: float, pen, lam, G):
+        """w k_N G̃ᵀ diag(A_j) G̃ over the active nodes − Σ_q Λ_q ∂²g_q (``G``: the rows of ``pen``)."""
+        active = np.flatnonzero(self.node_gap(kin) < 0.0)
+        if not active.size:
+            return sp.csr_matrix((self.n_dofs,) * 2)
+        Gt = self.mortar[active][:, np.flatnonzero(pen)] @ G
+        K = Gt.T @ sp.diags(self.weight * k_n * self.node_area[active]) @ Gt
+        Kh = self.contact_stiffness(kin, pen, lam)
+        return K if Kh is None else K + Kh
+
+
 class TwoBodySolver(CycleLegs):
     """Two elastic–plastic hemispheres on one axis; call ``run(h_max)`` (h = h₁ + h₂).
 
@@ -476,19 +539,24 @@ class TwoBodySolver(CycleLegs):
             self.passes = [ContactPass(self.slave, self.master, self.n_dofs)]
         else:
             n_gauss = self.options.segment_points
-            if n_gauss:
-                warnings.warn(SEGMENT_PAIR_WARNING, SegmentPairWarning, stacklevel=2)
-            self.passes = ([ContactPass(self.slave, self.master, self.n_dofs, 0.5),
-                            ContactPass(self.master, self.slave, self.n_dofs, 0.5)] if not n_gauss else
-                           [SegmentContactPass(self.slave, self.master, self.n_dofs, 0.5, n_gauss),
-                            SegmentContactPass(self.master, self.slave, self.n_dofs, 0.5, n_gauss)])
             x_arc = self.slave.hmesh.X[:, self.slave.hmesh.surface]
+            if not n_gauss:
+                self.passes = [ContactPass(self.slave, self.master, self.n_dofs, 0.5),
+                               ContactPass(self.master, self.slave, self.n_dofs, 0.5)]
+            elif self.options.segment_scheme == "mortar":  # one pass, the softer body's weighted gaps
+                self.slave_index = slave_index(material1, radius1, material2, radius2)
+                self.slave, self.master = self.bodies[self.slave_index], self.bodies[1 - self.slave_index]
+                self.passes = [MortarContactPass(self.slave, self.master, self.n_dofs, 1.0, n_gauss)]
+            else:
+                warnings.warn(SEGMENT_PAIR_WARNING, SegmentPairWarning, stacklevel=2)
+                self.passes = [SegmentContactPass(self.slave, self.master, self.n_dofs, 0.5, n_gauss),
+                               SegmentContactPass(self.master, self.slave, self.n_dofs, 0.5, n_gauss)]
             pole_edge = float(np.hypot(*(x_arc[:, 2] - x_arc[:, 0])))
             e_star = 1.0 / (1.0 / material1.E_prime + 1.0 / material2.E_prime)
             self.k_penalty = self.options.penalty * e_star / pole_edge
         #: the slave's surface nodes against the master: the exact contact, and the records
         #: (gap, reaction, contact edge per node) of segment-integrated penalty contact
-        self.contact = (ContactPass(self.slave, self.master, self.n_dofs, 0.5)
+        self.contact = (ContactPass(self.slave, self.master, self.n_dofs, self.passes[0].weight)
                         if isinstance(self.passes[0], SegmentContactPass) else self.passes[0])
         #: the smallest distance between neighbouring surface nodes of either body
         self._surface_spacing = min(float(np.hypot(*np.diff(b.hmesh.X[:, b.hmesh.surface], axis=1)).min())
@@ -508,7 +576,8 @@ class TwoBodySolver(CycleLegs):
         self._elastic = None
         #: penalty contact: solve on a fixed superset pattern (:meth:`_fixed_pattern`), one
         #: symbolic analysis per contact zone; False: the growing pattern of SymmetricSolver.solve
-        self.fixed_pattern = True
+        self.fixed_pattern = not isinstance(self.passes[0], MortarContactPass)
+        # (a mortar node's block couples the points of its two edges, beyond window_keys' pairs)
         self._pattern = None
         #: penalty contact: where the tangent is not positive definite, solve with it less the
         #: master-curvature part −λ ∂²g of the contact blocks (positive definite when the bodies'

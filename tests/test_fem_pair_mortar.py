@@ -1,0 +1,137 @@
+"""Penalty mortar contact of two bodies (twobody.MortarContactPass, ``segment_scheme`` "mortar")."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+from spherecontact.fem.solver import SolverOptions
+from spherecontact.fem.twobody import ContactPass, MortarContactPass, TwoBodySolver
+from spherecontact.model.material import Material
+
+SOFT, STIFF = Material(E=200.0, nu=0.3, sigma_y=1.0), Material(E=600.0, nu=0.3, sigma_y=1.0)
+
+
+def _pressed(options: SolverOptions, h: float = 2e-3):
+    """The pair E₂ = 3E₁, R₂ = 2R₁ and u: body 1 moved down by h, rigidly."""
+    s = TwoBodySolver(SOFT, 1.0, STIFF, 2.0, options=options)
+    b1 = s.bodies[0]
+    u = np.zeros(s.n_dofs)
+    u[b1.offset + 1:b1.offset + b1.n_dofs:2] = -h
+    return s, u
+
+
+def test_mortar_is_one_pass_of_the_softer_body_on_the_growing_pattern():
+    s, _ = _pressed(SolverOptions(penalty=100.0, segment_points=2, segment_scheme="mortar"))
+    (p,) = s.passes
+    assert isinstance(p, MortarContactPass) and p.weight == 1.0
+    assert p.slave is s.bodies[0] and s.slave is s.bodies[0]  # body 1: the lower E'
+    assert not s.fixed_pattern
+
+
+def test_hat_weights_are_a_positive_partition_of_the_slave_area():
+    """ψ_j ≥ 0, Σ_j A_j = the edges' area, every row of M sums to 1; the pole node's quadratic
+    shape function would give it no area (∫ N₀ r dr = 0 on an edge from the axis), its hat does."""
+    s, _ = _pressed(SolverOptions(penalty=100.0, segment_points=2, segment_scheme="mortar"))
+    p = s.passes[0]
+    assert p.mortar.data.min() > 0.0
+    assert p.node_area.sum() == pytest.approx(p.area0.sum(), rel=1e-13)
+    reached = p.node_area > 0
+    assert reached[:-1].all() and not reached[-1]  # the equator edge is no candidate
+    np.testing.assert_allclose(np.asarray(p.mortar.sum(axis=1)).ravel()[reached], 1.0, rtol=1e-13)
+    r = p.slave.hmesh.X[0, p.candidates[:3]]
+    L = r[2]  # first edge, from the axis: ∫ψ₀ 2πr dr over [0, L/2] = 2π (L/2)²/6
+    assert p.node_area[0] == pytest.approx(2 * np.pi * (L / 2) ** 2 / 6, rel=0.05)
+
+
+def test_mortar_tangent_is_the_derivative_of_its_force():
+    """w k_N G̃ᵀ diag(A_j) G̃ − Σ_q Λ_q ∂²g_q is −∂(Gᵀλ)/∂u (central differences); leaving out the
+    points of an active node's support that carry no own pressure (what the quadratic shape
+    functions' negative weights did) breaks it."""
+    s, u = _pressed(SolverOptions(penalty=100.0, segment_points=2, segment_scheme="mortar"))
+    p = s.passes[0]
+    rng = np.random.default_rng(1)
+    near = np.zeros(s.n_dofs)
+    for b in s.bodies:
+        nodes = b.hmesh.surface[b.hmesh.X[0, b.hmesh.surface] < 0.1]
+        near[b.offset + 2 * nodes] = near[b.offset + 2 * nodes + 1] = 1.0
+    d = rng.standard_normal(s.n_dofs) * near * 1e-6
+    kin = p.kinematics(u)
+    pen, lam, _ = p.penalty_force(kin, s.k_penalty)
+    assert (p.node_gap(kin) < 0).sum() >= 20 and lam.min() >= 0.0
+    K = p.penalty_tangent(kin, s.k_penalty, pen, lam, p.constraints(kin, pen, lam)[0])
+    eps = 1e-3
+    up, down = (p.penalty_force(p.kinematics(u + sign * eps * d), s.k_penalty)[2] for sign in (1, -1))
+    fd = (up - down) / (2 * eps)
+    assert np.abs(fd + K @ d).max() <= 1e-6 * np.abs(K @ d).max()
+
+
+def _load_ratio(force, body, n=5):
+    """Midside over neighbouring corner load per unit circumference, first ``n`` midside nodes."""
+    arc = body.hmesh.surface
+    q = np.abs(force[body.offset + 2 * arc + 1])[1:2 * n + 2] / body.hmesh.X[0, arc][1:2 * n + 2]
+    return q[0::2][:n] / q[1::2][:n]
+
+
+def test_the_master_curve_spreads_a_uniform_pressure_evenly_over_its_nodes():
+    """Where the sawtooth of the one-pass surfaces comes from: a nearly uniform pressure reaches
+    the slave's quadratic edges as their consistent loads (midside twice a corner's share,
+    ∫N dA 2/3 against 2 · 1/6 of an edge), but reaches the master through its Catmull–Rom
+    curve, whose basis gives every node the same share. The master's corners carry 1.5× their
+    consistent load and its midsides 0.75×: corners pressed in, midsides standing out."""
+    s, u = _pressed(SolverOptions(penalty=100.0, segment_points=2, segment_scheme="mortar"))
+    p = s.passes[0]
+    force = p.penalty_force(p.kinematics(u), s.k_penalty)[2]
+    np.testing.assert_allclose(_load_ratio(force, p.slave), 2.0, atol=0.05)
+    np.testing.assert_allclose(_load_ratio(force, p.master), 1.0, atol=0.05)
+
+
+def test_elastic_mortar_pair_is_hertz_and_splits_as_hertz_with_either_body_as_slave():
+    """The elastic pair E₂ = 3E₁, R₂ = 2R₁ (approach-scaled penalty, default mesh) to h = 2e-3:
+    with the solver's slave (the softer body) F against the contact radius is Hertz's with E*, R*
+    within 1.5 %; with either body as slave the split is the elastic E₂'/(E₁' + E₂') within 1
+    point (0.55 at most, nodal contact 0.3). F(h) with the stiffer body as slave lies up to 1.3 % below (contact 3–6 surface nodes
+    wide: its master, the soft body, takes the Catmull–Rom loads of the test above)."""
+    m1, m2 = Material(E=200.0, nu=0.3, sigma_y=1e9), Material(E=600.0, nu=0.2, sigma_y=1e9)
+    opts = SolverOptions(penalty=3000.0, penalty_scale="approach", segment_points=2, segment_scheme="mortar")
+    runs = []
+    for which in (0, 1):
+        s = TwoBodySolver(m1, 1.0, m2, 2.0, options=opts)
+        if which == 1:  # the stiffer body's weighted gaps
+            s.slave, s.master = s.bodies[1], s.bodies[0]
+            s.passes = [MortarContactPass(s.slave, s.master, s.n_dofs, 1.0, 2)]
+            s.contact = ContactPass(s.slave, s.master, s.n_dofs, 1.0)
+            s.candidates = s.contact.candidates
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            runs.append(s.run(2e-3))
+    run, other = runs
+    assert run.status == other.status == "converged"
+    Es = 1.0 / (1.0 / m1.E_prime + 1.0 / m2.E_prime)
+    a = run.curves["a_ref"]
+    sel = a >= 0.02
+    assert sel.sum() >= 5
+    assert np.abs(run.F[sel] / (4 * Es * a[sel] ** 3 / (3 * 2.0 / 3.0)) - 1).max() < 0.015
+    elastic = m2.E_prime / (m1.E_prime + m2.E_prime)
+    for r in runs:
+        late = r.h > 5e-4
+        assert np.abs(r.curves["h1"][late] / r.h[late] - elastic).max() < 0.01
+    late = run.h > 5e-4
+    assert np.abs(np.interp(run.h[late], other.h, other.F) / run.F[late] - 1).max() < 0.015
+
+
+@pytest.mark.parametrize("kw, words", [
+    ({"penalty": 100.0, "segment_points": 2, "segment_scheme": "dual"}, "segment_scheme"),
+    ({"penalty": 100.0, "segment_scheme": "mortar"}, "segment_points"),
+])
+def test_bad_segment_schemes_are_named(kw, words):
+    with pytest.raises(ValueError, match=words):
+        SolverOptions(**kw).validate()
+
+
+def test_a_rigid_obstacle_refuses_the_mortar_scheme():
+    from spherecontact.fem.solver import IndentationSolver
+
+    with pytest.raises(ValueError, match="segment_scheme 'mortar' is for two deformable bodies"):
+        IndentationSolver(SOFT, options=SolverOptions(penalty=100.0, segment_points=2,
+                                                      segment_scheme="mortar"))
