@@ -7,7 +7,7 @@ export OMP_NUM_THREADS ?= 1
 export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
-.PHONY: test bench lint verify-fem verify-pair verify-pair-speed verify-pair-surface verify-cycles verify-smoothness verify-band verify-increments demo clean
+.PHONY: test bench lint verify-fem verify-pair verify-pair-speed verify-pair-surface verify-pair-contacts verify-cycles verify-smoothness verify-band verify-increments demo clean
 .PHONY: fem fem-v1 campaign-design
 .PHONY: validate
 .PHONY: calibrate
@@ -66,6 +66,10 @@ verify-pair-speed: $(STAMP)
 # corner/midside sawtooth of the contact surfaces of every stored two-body run
 verify-pair-surface: $(STAMP)
 	$(PY) -m spherecontact.fem.pair_surface --db data/reference_v2.h5 data/reference.h5 --out reports/fem
+
+# the equal-hardness pairs' split under nodal, Gauss-point and mortar contact (~30 min)
+verify-pair-contacts: $(STAMP)
+	$(PY) -m spherecontact.fem.pair_contacts --out reports/fem
 
 validate: $(STAMP)
 	$(PY) -m spherecontact.validation --db data/reference_v2.h5 --coefficients data/coefficients.json \

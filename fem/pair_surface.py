@@ -59,11 +59,16 @@ def run_surfaces(run) -> dict:
     solver = TwoBodySolver(run.material(), inp["radius"], run.material2(), inp["radius2"],
                            density=inp["mesh_density"], element=inp["element"],
                            edge_band=inp.get("edge_band", 0.0), band_floor=inp.get("band_floor"))
-    X, u = run.mesh["X"], run.mesh["u"].reshape(-1, 2).T
+    return final_surfaces(solver, run.mesh["X"], run.mesh["u"], float(np.max(run.a)))
+
+
+def final_surfaces(solver: TwoBodySolver, X: np.ndarray, u: np.ndarray, a_max: float) -> dict:
+    """:func:`run_surfaces` on a final mesh (``RunResult.final``'s X (2, n) and u (2n,), both bodies
+    in physical coordinates) and the bodies of the ``solver`` that made it."""
+    u = np.asarray(u).reshape(-1, 2).T
     n1 = solver.bodies[0].hmesh.n_nodes
     if X.shape[1] != n1 + solver.bodies[1].hmesh.n_nodes:
         return {"mesh_matches": False}
-    a_max = float(np.max(run.a))
     out: dict = {"mesh_matches": True, "a_max": a_max, "zone": ZONE}
     for i, body in enumerate(solver.bodies):
         nodes = body.hmesh.surface + (0 if i == 0 else n1)

@@ -106,21 +106,21 @@ APPROACH_DEPTH = 0.1
 #: candidate) and the cubic's extension can pass the point: campaign v1's pair E₂ = 3E₁ (default
 #: mesh, P = 3000) took such a point for one sunk 0.07–0.47 R deep at h/R 0.19 and stopped there
 OFF_CURVE = 0.5
-#: segment-integrated two-body contact (``segment_points`` > 0) agrees with nodal contact at small
-#: approaches, and on a pair whose interface does not slide. Where the surfaces slide it parts
-#: from nodal contact, and it is not settled which is right (data/README.md, "Surface band of the
-#: pairs"). On campaign v1's pair E₂ = 3E₁ (P = 3000, band 0.03, 3 Gauss points per edge):
-#: - the split h₁/h is 0.808 against 0.708 at h/R 0.05, and 0.950 against 0.522 at 0.3 (the stored
-#:   nodal run: 0.54);
-#: - the Gauss-point pressure alternates by a factor 2–3 from edge to edge;
-#: - nodal two-pass contact leaves a corner/midside sawtooth on both surfaces (``pair_surface.py``)
-#:   (rms second difference 2.7e-3 R at h/R 0.1, against 1e-4 R here).
-#: Below h/R 0.02 the curves agree with nodal contact within 0.5 % in F, and with Hertz within
-#: 0.49 % (``make verify-pair``'s elastic pair, 2× mesh).
-SEGMENT_PAIR_WARNING = ("segment-integrated contact of two bodies (segment_points > 0) and nodal contact "
-                        "disagree where the surfaces slide, from h/R ~ 0.03 on (split h1/h 0.95 against "
-                        "0.52 at h/R 0.3 on an E-ratio-3 pair), and which is right is open: reference "
-                        "runs keep nodal contact")
+#: Gauss-point two-body contact (``segment_points`` > 0, ``segment_scheme`` "points") agrees with
+#: nodal contact at small approaches, and on a pair whose interface does not slide. Where the
+#: surfaces slide it runs the split away from what one-pass mortar contact gives with either body
+#: as slave, and nodal contact stays with the mortar (``pair_contacts.py``,
+#: reports/fem/split_contacts.json; P = 3000). h₁/h at h/R 0.04 on campaign v1's pair E₂ = 3E₁
+#: (band 0.03): Gauss points 0.790, mortar in two passes 0.784, one-pass mortar 0.712 / 0.710 with
+#: body 1 / body 2 as slave, nodal 0.719 (at 0.05: 0.808, 0.803, 0.701 with body 1, 0.708). On the
+#: pair E₂ = 1.05 E₁ (equal radii):
+#: Gauss points 0.517 / 0.625 / 0.701 at h/R 0.1 / 0.15 / 0.2, one-pass mortar 0.49–0.53 to
+#: 0.13–0.14, nodal 0.510–0.512. Below h/R 0.02 the curves agree with nodal contact within 0.5 %
+#: in F, and with Hertz within 0.49 % (``make verify-pair``'s elastic pair, 2× mesh).
+SEGMENT_PAIR_WARNING = ("Gauss-point contact of two bodies (segment_points > 0, segment_scheme 'points') "
+                        "runs the split h1/h away where the surfaces slide (0.81 at h/R 0.05 on an "
+                        "E-ratio-3 pair, where one-pass mortar contact with either body as slave and "
+                        "nodal contact give 0.70-0.71): reference runs keep nodal contact")
 
 
 class SegmentPairWarning(UserWarning):
@@ -448,6 +448,18 @@ class MortarContactPass(SegmentContactPass):
     the fixed matrix M_jq = ψ_j(ξ_q) A_q / A_j; the points carry Λ_q = Σ_j M_jq λ_j ≥ 0, and
 
         Gᵀλ = Σ_q Λ_q ∂g_q,   ∂(Gᵀλ)/∂u = −w k_N G̃ᵀ diag(A_j) G̃ + Σ_q Λ_q ∂²g_q,   G̃ = M G.
+
+    Its split does not depend on which body is the slave where it runs (``pair_contacts.py``), and
+    there it sides with nodal contact, not with the Gauss points. How far it runs is limited by the
+    master: its loads come through the Catmull–Rom curve, whose basis gives every node the same
+    share of a uniform pressure where the quadratic edge's consistent shares are 1 : 4 : 1. The
+    master's corners are pressed in, its surface grows a sawtooth (rms second difference 7–9e-4 R
+    at h/R 0.05 on the E-ratio-3 band pair, the slave's 1e-4 R), and Newton stalls: at h/R
+    0.045–0.052 on that pair and on the radius-ratio-2 pair with the larger sphere as slave, at
+    0.13–0.14 on the E ratio 1.05 pair. The master's own quadratic edges give the
+    consistent loads but are C⁰ at their corners: with them Newton cycled without any change of
+    the active set (points switching edges; tried 2026-11-28). A C¹ master curve with consistent
+    loads is what it needs.
     """
 
     def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 2):

@@ -136,3 +136,26 @@ def test_a_rigid_obstacle_refuses_the_mortar_scheme():
     with pytest.raises(ValueError, match="segment_scheme 'mortar' is for two deformable bodies"):
         IndentationSolver(SOFT, options=SolverOptions(penalty=100.0, segment_points=2,
                                                       segment_scheme="mortar"))
+
+
+def test_pair_contacts_builds_the_five_discretisations_and_reads_the_split():
+    """``fem.pair_contacts``: the passes of each contact, and one short run's figures."""
+    from spherecontact.fem.pair_contacts import CONTACTS, Scene, pair_solver, run_one
+    from spherecontact.fem.twobody import SegmentContactPass
+
+    scene = Scene("near-equal", 210.0, 1.0, 0.0, 0.011)
+    kinds = {}
+    for c in CONTACTS:
+        s = pair_solver(scene, c)
+        kinds[c] = ([type(p) for p in s.passes], s.passes[0].slave is s.bodies[0],
+                    s.slave is s.passes[0].slave)
+    assert kinds["nodal"][0] == [ContactPass, ContactPass]
+    assert kinds["points"][0] == [SegmentContactPass, SegmentContactPass]
+    assert kinds["mortar"][0] == [MortarContactPass] and kinds["mortar"][1]  # body 1: the lower E'
+    assert kinds["mortar, other slave"][0] == [MortarContactPass] and not kinds["mortar, other slave"][1]
+    assert kinds["mortar, two passes"][0] == [MortarContactPass] * 2
+    assert all(k[2] for k in kinds.values())  # the records read the first pass's slave
+    row = run_one(scene, "mortar, other slave")
+    assert row["status"] == "converged" and row["slave"] == 2 and row["approaches"] == [0.01]
+    assert abs(row["split"][0] - 0.512) < 0.005  # elastic–plastic start: near E2'/(E1' + E2') = 0.512
+    assert row["surfaces"]["mesh_matches"] and row["surfaces"]["body1"]["nodes"] >= 10

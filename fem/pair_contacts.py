@@ -1,0 +1,127 @@
+"""Which split is right: equal-hardness pairs under five contact discretisations.
+
+Two spheres of equal yield stress share the approach h = h₁ + h₂ in a way that the contact
+discretisation can move where the interface slides (data/README.md, "Surface band of the
+pairs"). Each scene is run with the approach-scaled penalty (P = 3000, no cycles) and
+
+* ``nodal``: the two-pass nodal penalty of the reference runs;
+* ``points``: 3 Gauss points per slave edge, each its own penalty, both bodies in turn
+  (``segment_scheme`` "points");
+* ``mortar``: one pass of the softer body's weighted gaps (``segment_scheme`` "mortar",
+  2 points per half edge; :class:`~.twobody.MortarContactPass`);
+* ``mortar, other slave``: the same with the other body's weighted gaps;
+* ``mortar, two passes``: both bodies' weighted gaps in turn, half the stiffness each.
+
+One-pass mortar is the discretisation whose answer must not depend on which body is the slave;
+where its two slave choices agree, that is the split the others are read against. Recorded per
+run: status, end, wall time, h₁/h and F at ``APPROACHES``, and the corner/midside sawtooth of
+both final surfaces (:func:`~.pair_surface.final_surfaces`).
+
+``python -m spherecontact.fem.pair_contacts --out reports/fem`` → ``split_contacts.json``
+(about 30 min on two cores).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..model.material import Material
+from .pair_surface import final_surfaces
+from .solver import SolverOptions
+from .twobody import ContactPass, MortarContactPass, SegmentPairWarning, TwoBodySolver
+
+#: relative penalty of the approach scaling (the bodies sink in by about h/P)
+PENALTY = 3000.0
+#: approaches (h/R of the smaller sphere) at which the split and F are read
+APPROACHES = (0.01, 0.02, 0.04, 0.05, 0.1, 0.13, 0.15, 0.2)
+CONTACTS = ("nodal", "points", "mortar", "mortar, other slave", "mortar, two passes")
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A pair of spheres of equal yield stress (body 1: E/σY 200, ν 0.3, R₁ = 1)."""
+
+    name: str
+    E2: float
+    radius2: float
+    edge_band: float
+    h_max: float
+
+
+SCENES = (
+    # campaign v1's pairs two-pp-E200-nu0.3-vs-E600 and -vs-R2 on the band mesh
+    Scene("E2 = 3 E1", 600.0, 1.0, 0.03, 0.06),
+    Scene("R2 = 2 R1", 200.0, 2.0, 0.03, 0.15),
+    Scene("E2 = 1.05 E1", 210.0, 1.0, 0.0, 0.2),
+)
+
+
+def pair_solver(scene: Scene, contact: str) -> TwoBodySolver:
+    """The scene's solver with ``contact`` (one of :data:`CONTACTS`)."""
+    seg = {"nodal": (0, "points"), "points": (3, "points")}.get(contact, (2, "mortar"))
+    opts = SolverOptions(penalty=PENALTY, penalty_scale="approach", segment_points=seg[0],
+                         segment_scheme=seg[1])
+    m1 = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    m2 = Material(E=scene.E2, nu=0.3, sigma_y=1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", SegmentPairWarning)
+        s = TwoBodySolver(m1, 1.0, m2, scene.radius2, options=opts, edge_band=scene.edge_band)
+    if contact == "mortar, other slave":
+        s.slave, s.master = s.master, s.slave
+        s.passes = [MortarContactPass(s.slave, s.master, s.n_dofs, 1.0, 2)]
+    elif contact == "mortar, two passes":
+        s.passes = [MortarContactPass(a, b, s.n_dofs, 0.5, 2)
+                    for a, b in ((s.slave, s.master), (s.master, s.slave))]
+    s.contact = ContactPass(s.slave, s.master, s.n_dofs, 1.0)
+    s.candidates = s.contact.candidates
+    return s
+
+
+def run_one(scene: Scene, contact: str) -> dict:
+    """One scene with one contact: the figures of the module docstring."""
+    s = pair_solver(scene, contact)
+    t0 = time.perf_counter()
+    res = s.run(scene.h_max)
+    wall = time.perf_counter() - t0
+    h, F, h1 = (np.asarray(res.curves[k], dtype=float) for k in ("h", "F", "h1"))
+    at = [x for x in APPROACHES if x <= h[-1] * (1 + 1e-3)]  # h_max itself, reached to round-off
+    return {"scene": scene.name, "contact": contact, "status": res.status, "reason": res.reason,
+            "h_end": float(h[-1]), "wall_s": wall, "slave": 1 if s.slave is s.bodies[0] else 2,
+            "approaches": at, "split": [float(np.interp(x, h, h1 / h)) for x in at],
+            "F": [float(np.interp(x, h, F)) for x in at],
+            "surfaces": final_surfaces(s, res.final["X"], res.final["u"], float(np.max(res.a)))}
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="reports/fem")
+    ap.add_argument("--workers", type=int, default=2)
+    args = ap.parse_args(argv)
+    jobs = [(scene, c) for scene in SCENES for c in CONTACTS]
+    rows = []
+    with ProcessPoolExecutor(max_workers=args.workers) as pool:
+        futures = [pool.submit(run_one, *job) for job in jobs]
+        for done, fut in enumerate(as_completed(futures), 1):
+            row = fut.result()
+            rows.append(row)
+            split = " ".join(f"{x:g}:{v:.3f}" for x, v in zip(row["approaches"], row["split"], strict=True))
+            print(f"[{done}/{len(jobs)}] {row['scene']}, {row['contact']}: {row['status']} to h/R "
+                  f"{row['h_end']:.3f} in {row['wall_s']:.0f} s; h1/h {split}", flush=True)
+    order = {job: i for i, job in enumerate((s.name, c) for s, c in jobs)}
+    rows.sort(key=lambda r: order[(r["scene"], r["contact"])])
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "split_contacts.json").write_text(json.dumps(rows, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
