@@ -41,7 +41,7 @@ from .linsolve import ConstrainedPattern, SymmetricSolver
 from .mesh import REVERSED, build_mesh
 from .plasticity import PlasticState, stress_update, tangent
 from .segment_penalty import edge_gauss_points
-from .segments import gap_gradient, gap_hessian
+from .segments import CATMULL_ROM, SMOOTH_EDGE, gap_gradient, gap_hessian
 from .solver import (
     ROUNDOFF,
     CycleLegs,
@@ -207,6 +207,9 @@ class ContactPass:
     contact, so that an equal pair sees the stiffness of one pass).
     """
 
+    #: the master curve's basis (:mod:`.segments`): Catmull–Rom through its surface nodes
+    basis = CATMULL_ROM
+
     def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0):
         self.slave, self.master, self.n_dofs, self.weight = slave, master, n_dofs, weight
         self.candidates = slave.hmesh.surface[:-1]  # slave contact nodes, from the pole
@@ -262,10 +265,11 @@ class ContactPass:
         last = self.ctrl_nodes.shape[1] - 1
         # the interval holding t: the one ending at the nearest master node, else the one starting
         # there (projected only for the points whose t fell outside the first)
-        best, excess = self._projected(xs, u, np.clip(k - 1, 0, last))
+        first, second = self._intervals_at(k)
+        best, excess = self._projected(xs, u, np.clip(first, 0, last))
         redo = np.flatnonzero(excess > 0.0)
         if redo.size:
-            here, excess_here = self._projected(xs[:, redo], u, np.clip(k[redo], 0, last))
+            here, excess_here = self._projected(xs[:, redo], u, np.clip(second[redo], 0, last))
             better = excess_here < excess[redo]
             rows = redo[better]
             for old, new in zip(best, here, strict=True):
@@ -273,36 +277,41 @@ class ContactPass:
             excess[rows] = excess_here[better]
         return best, excess
 
+    def _intervals_at(self, k: np.ndarray):
+        """The master intervals ending and starting at master arc node ``k``."""
+        return k - 1, k
+
     def _projected(self, xs, u, seg) -> tuple[Kinematics, np.ndarray]:
         """Kinematics of the points ``xs`` projected on the master intervals ``seg``, and how far
         outside [0, 1] each projection's t lies."""
         coords = self._coords(xs, u, seg)
-        gap, grad, t, normal = gap_gradient(coords, self.side)
+        gap, grad, t, normal = gap_gradient(coords, self.side, self.basis)
         return Kinematics(seg, coords, gap, grad, normal), np.maximum(np.maximum(-t, t - 1.0), 0.0)
 
     def _coords(self, xs, u, seg):
-        """(10, n): slave positions ``xs`` and the control points of intervals ``seg``."""
+        """(2 + 2k, n): slave positions ``xs`` and the k control points of intervals ``seg``."""
         nodes, rsign = self.ctrl_nodes[:, seg], self.ctrl_rsign[:, seg]
-        P = self.master.positions(u, nodes.ravel()).reshape(2, 4, -1)
+        k = nodes.shape[0]
+        P = self.master.positions(u, nodes.ravel()).reshape(2, k, -1)
         P[0] *= rsign
-        return np.concatenate([xs, P.transpose(1, 0, 2).reshape(8, -1)])
+        return np.concatenate([xs, P.transpose(1, 0, 2).reshape(2 * k, -1)])
 
     def _dofs_and_signs(self, seg: np.ndarray, rows: np.ndarray):
         """Global dofs (10, n) and coordinate signs (10, n) of the pairs ``rows``."""
         return self._pair_dofs(rows, seg[rows])
 
     def _pair_dofs(self, rows: np.ndarray, seg: np.ndarray):
-        """Global dofs (2k + 8, n) and coordinate signs of contact points ``rows`` on intervals
-        ``seg``: the k slave nodes of each point, then the master's four control points."""
+        """Global dofs (2k + 2c, n) and coordinate signs of contact points ``rows`` on intervals
+        ``seg``: the k slave nodes of each point, then the master's c control points."""
         s, m = self.slave, self.master
-        k = self.point_nodes.shape[0]
-        nodes = np.concatenate([self.point_nodes[:, rows], self.ctrl_nodes[:, seg]])  # (k + 4, n)
-        offset = np.array([s.offset] * k + [m.offset] * 4)[:, None]
-        zsign = np.array([s.zsign] * k + [m.zsign] * 4)[:, None]
+        k, c = self.point_nodes.shape[0], self.ctrl_nodes.shape[0]
+        nodes = np.concatenate([self.point_nodes[:, rows], self.ctrl_nodes[:, seg]])  # (k + c, n)
+        offset = np.array([s.offset] * k + [m.offset] * c)[:, None]
+        zsign = np.array([s.zsign] * k + [m.zsign] * c)[:, None]
         r_dof = offset + 2 * nodes
-        dofs = np.stack([r_dof, r_dof + 1], axis=1).reshape(2 * (k + 4), rows.size)  # r, z of each node
+        dofs = np.stack([r_dof, r_dof + 1], axis=1).reshape(2 * (k + c), rows.size)  # r, z of each node
         rsign = np.concatenate([np.ones((k, rows.size)), self.ctrl_rsign[:, seg]])
-        signs = np.stack([rsign, np.broadcast_to(zsign, rsign.shape)], axis=1).reshape(2 * (k + 4), rows.size)
+        signs = np.stack([rsign, np.broadcast_to(zsign, rsign.shape)], axis=1).reshape(2 * (k + c), rows.size)
         return dofs, signs
 
     def constraints(self, kin: Kinematics, active: np.ndarray, lam: np.ndarray):
@@ -324,7 +333,7 @@ class ContactPass:
         if not rows.size:
             return None
         dofs, signs = self._dofs_and_signs(kin.seg, rows)
-        H = self._expand_hessian(gap_hessian(kin.coords[:, rows], self.side), rows)
+        H = self._expand_hessian(gap_hessian(kin.coords[:, rows], self.side, self.basis), rows)
         H = H * signs[:, None, :] * signs[None, :, :]
         vals = -(H * lam[rows]).ravel()
         m = dofs.shape[0]
@@ -348,7 +357,7 @@ class ContactPass:
         rows = np.flatnonzero(pen)
         dofs, signs = self._dofs_and_signs(kin.seg, rows)
         gl = self._expand(kin.grad[:, rows], rows) * signs
-        H = self._expand_hessian(gap_hessian(kin.coords[:, rows], self.side), rows)
+        H = self._expand_hessian(gap_hessian(kin.coords[:, rows], self.side, self.basis), rows)
         H = H * signs[:, None, :] * signs[None, :, :]
         kA = self.weight * k_n * self.area0[rows]
         return dofs, kA * gl[:, None, :] * gl[None, :, :], -lam[rows] * H
@@ -425,11 +434,11 @@ class SegmentContactPass(ContactPass):
 
     def _expand_hessian(self, H: np.ndarray, rows: np.ndarray) -> np.ndarray:
         W = self.point_weights[:, rows]
-        n = rows.size
-        J = np.zeros((14, 10, n))  # ∂coords/∂(pair dofs), per point
+        n, m = rows.size, H.shape[0] - 2  # m: the master's coordinates
+        J = np.zeros((6 + m, 2 + m, n))  # ∂coords/∂(pair dofs), per point
         for a in range(3):
             J[2 * a, 0], J[2 * a + 1, 1] = W[a], W[a]
-        J[6 + np.arange(8), 2 + np.arange(8)] = 1.0
+        J[6 + np.arange(m), 2 + np.arange(m)] = 1.0
         return np.einsum("ain,ijn,bjn->abn", J, H, J, optimize=True)
 
 
@@ -462,7 +471,10 @@ class MortarContactPass(SegmentContactPass):
     loads is what it needs.
     """
 
-    def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 2):
+    def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 2,
+                 smooth_edges: bool = True):
+        if smooth_edges:
+            self.basis = SMOOTH_EDGE
         ContactPass.__init__(self, slave, master, n_dofs, weight)
         arc = slave.hmesh.surface
         edges, N, area, r0 = edge_gauss_points(slave.hmesh.X[:, arc], n_gauss, halves=True)
@@ -483,6 +495,21 @@ class MortarContactPass(SegmentContactPass):
         scale = np.divide(1.0, self.node_area, out=np.zeros_like(self.node_area), where=self.node_area > 0)
         self.mortar = (sp.diags(scale) @ raw).tocsr()
         self.mortar_t = self.mortar.T.tocsr()
+
+    def _control_points(self):
+        """With :data:`~.segments.SMOOTH_EDGE`: [c₋, c₀, c₁, m₋, m, m₊, c₊] of every master edge but
+        the equator's (7, n_edges); before the pole the mirror images of the first edge's nodes."""
+        if self.basis is not SMOOTH_EDGE:
+            return super()._control_points()
+        arc = self.master_arc
+        c0 = np.arange(0, arc.size - 3, 2)
+        pos = np.stack([c0 - 2, c0, c0 + 2, c0 - 1, c0 + 1, c0 + 3, c0 + 4])
+        return arc[np.abs(pos)], np.where(pos < 0, -1.0, 1.0)
+
+    def _intervals_at(self, k: np.ndarray):
+        if self.basis is not SMOOTH_EDGE:
+            return super()._intervals_at(k)
+        return (k - 1) // 2, k // 2
 
     def node_gap(self, kin: Kinematics) -> np.ndarray:
         """Weighted gap g̃_j of every slave node (+inf where no edge point reaches it)."""

@@ -53,6 +53,36 @@ def test_gap_gradient_and_hessian_match_finite_differences():
     np.testing.assert_allclose(H, H.transpose(1, 0, 2), atol=1e-12)
 
 
+def test_smooth_edge_gap_derivatives_match_finite_differences():
+    """The master's quadratic edge made C¹ (segments.SMOOTH_EDGE, 7 control points): the gap is the
+    distance to the circle the nodes lie on, and its gradient and complex-step Hessian are the
+    finite differences of the gap and the gradient."""
+    from spherecontact.fem.segments import SMOOTH_EDGE
+
+    rng = np.random.default_rng(2)
+    n = 6
+    th = 0.1 + 0.02 * np.array([-2, 0, 2, -1, 1, 3, 4])  # c₋, c₀, c₁, m₋, m, m₊, c₊ along the arc
+    C = np.zeros((16, n))
+    for k in range(7):
+        C[2 + 2 * k] = np.sin(th[k])
+        C[3 + 2 * k] = np.cos(th[k]) - 1.0
+    C[0] = rng.uniform(0.1, 0.14, n)
+    C[1] = np.cos(C[0]) - 1.0 + rng.uniform(-1e-3, 1e-3, n)
+    gap, grad, t, _ = gap_gradient(C, 1.0, SMOOTH_EDGE)
+    assert np.all((t > 0) & (t < 1))
+    np.testing.assert_allclose(gap, np.hypot(C[0], C[1] + 1.0) - 1.0, atol=1e-7)
+    H = gap_hessian(C, 1.0, SMOOTH_EDGE)
+    eps = 1e-6
+    for j in range(16):
+        Cp, Cm = C.copy(), C.copy()
+        Cp[j] += eps
+        Cm[j] -= eps
+        gp, gm = gap_gradient(Cp, 1.0, SMOOTH_EDGE), gap_gradient(Cm, 1.0, SMOOTH_EDGE)
+        np.testing.assert_allclose(grad[j], (gp[0] - gm[0]) / (2 * eps), atol=1e-8)
+        np.testing.assert_allclose(H[:, j], (gp[1] - gm[1]) / (2 * eps), atol=1e-5)
+    np.testing.assert_allclose(H, H.transpose(1, 0, 2), atol=1e-10)
+
+
 def test_early_stopped_projection_equals_the_fully_iterated_one(monkeypatch):
     """The projection stops at PROJECTION_TOL; gap, gradient and complex-step Hessian are those
     of Newton iterated far past convergence to round-off, also for t outside [0, 1]."""
