@@ -21,6 +21,13 @@ carries the curvature of the master and makes Newton quadratic, is the
 complex-step derivative of that gradient (every operation here is analytic;
 Squire & Trapp 1998), 10×10 per node. Coordinates are ordered
 [x_s, P₀, P₁, P₂, P₃] × (r, z).
+
+The Catmull–Rom basis gives every master node the same share of a uniform pressure; the
+quadratic edge's consistent shares are 1/6, 2/3, 1/6 of an edge, so a master loaded through
+it has its corner nodes pressed in and grows a corner/midside sawtooth. :data:`SMOOTH_EDGE`
+is the alternative the mortar contact uses: one master edge (two corners, a midside) per
+interval, made C¹ through its corners with the neighbouring edges' nodes, seven control points,
+the consistent shares kept. Any basis of polynomials in t works the same way (``basis``).
 """
 
 from __future__ import annotations

@@ -106,21 +106,23 @@ APPROACH_DEPTH = 0.1
 #: candidate) and the cubic's extension can pass the point: campaign v1's pair E₂ = 3E₁ (default
 #: mesh, P = 3000) took such a point for one sunk 0.07–0.47 R deep at h/R 0.19 and stopped there
 OFF_CURVE = 0.5
-#: Gauss-point two-body contact (``segment_points`` > 0, ``segment_scheme`` "points") agrees with
-#: nodal contact at small approaches, and on a pair whose interface does not slide. Where the
-#: surfaces slide it runs the split away from what one-pass mortar contact gives with either body
-#: as slave, and nodal contact stays with the mortar (``pair_contacts.py``,
-#: reports/fem/split_contacts.json; P = 3000). h₁/h at h/R 0.04 on campaign v1's pair E₂ = 3E₁
-#: (band 0.03): Gauss points 0.790, mortar in two passes 0.784, one-pass mortar 0.712 / 0.710 with
-#: body 1 / body 2 as slave, nodal 0.719 (at 0.05: 0.808, 0.803, 0.701 with body 1, 0.708). On the
-#: pair E₂ = 1.05 E₁ (equal radii):
-#: Gauss points 0.517 / 0.625 / 0.701 at h/R 0.1 / 0.15 / 0.2, one-pass mortar 0.49–0.53 to
-#: 0.13–0.14, nodal 0.510–0.512. Below h/R 0.02 the curves agree with nodal contact within 0.5 %
-#: in F, and with Hertz within 0.49 % (``make verify-pair``'s elastic pair, 2× mesh).
-SEGMENT_PAIR_WARNING = ("Gauss-point contact of two bodies (segment_points > 0, segment_scheme 'points') "
-                        "runs the split h1/h away where the surfaces slide (0.81 at h/R 0.05 on an "
-                        "E-ratio-3 pair, where one-pass mortar contact with either body as slave and "
-                        "nodal contact give 0.70-0.71): reference runs keep nodal contact")
+#: segment-integrated two-body contact (``segment_points`` > 0: Gauss points, or mortar) agrees
+#: with nodal contact at small approaches, where the yield stresses differ, and on an equal pair
+#: under the two-pass schemes. Where two spheres of (near-)equal yield stress slide past each other
+#: beyond h/R ≈ 0.05 their split is unstable with smooth frictionless surfaces and follows whatever
+#: asymmetry there is (``pair_contacts.py``, reports/fem/split_contacts.json, P = 3000): on
+#: campaign v1's pair E₂ = 3E₁ (band 0.03) h₁/h at h/R 0.1 / 0.2 is 0.873 / 0.927 with Gauss
+#: points, 0.872 / 0.927 with the mortar on its smooth master, 0.666 / 0.606 with nodal contact,
+#: whose corner/midside sawtooth interlocks the surfaces; on the pair E₂ = 1.05 E₁ the mortar runs
+#: it towards its master (0.368 with body 1 as slave, 0.655 with body 2, at h/R 0.1), the Gauss
+#: points later (0.625 at 0.15), nodal contact holds 0.511. Below h/R 0.02 the curves agree with
+#: nodal contact within 0.5 % in F, and with Hertz within 0.49 % (``make verify-pair``'s elastic
+#: pair, 2× mesh; the mortar within 1.5 % on the default mesh).
+SEGMENT_PAIR_WARNING = ("the split h1/h of two spheres of (near-)equal yield stress beyond h/R ~ 0.05 "
+                        "depends on the contact: smooth surfaces (segment_points > 0) let it run away "
+                        "(0.93 against nodal contact's 0.61 at h/R 0.2 on an E-ratio-3 pair; towards the "
+                        "mortar's master when the bodies are nearly equal), the nodal sawtooth holds it: "
+                        "reference runs keep nodal contact")
 
 
 class SegmentPairWarning(UserWarning):
@@ -458,17 +460,13 @@ class MortarContactPass(SegmentContactPass):
 
         Gᵀλ = Σ_q Λ_q ∂g_q,   ∂(Gᵀλ)/∂u = −w k_N G̃ᵀ diag(A_j) G̃ + Σ_q Λ_q ∂²g_q,   G̃ = M G.
 
-    Its split does not depend on which body is the slave where it runs (``pair_contacts.py``), and
-    there it sides with nodal contact, not with the Gauss points. How far it runs is limited by the
-    master: its loads come through the Catmull–Rom curve, whose basis gives every node the same
-    share of a uniform pressure where the quadratic edge's consistent shares are 1 : 4 : 1. The
-    master's corners are pressed in, its surface grows a sawtooth (rms second difference 7–9e-4 R
-    at h/R 0.05 on the E-ratio-3 band pair, the slave's 1e-4 R), and Newton stalls: at h/R
-    0.045–0.052 on that pair and on the radius-ratio-2 pair with the larger sphere as slave, at
-    0.13–0.14 on the E ratio 1.05 pair. The master's own quadratic edges give the
-    consistent loads but are C⁰ at their corners: with them Newton cycled without any change of
-    the active set (points switching edges; tried 2026-11-28). A C¹ master curve with consistent
-    loads is what it needs.
+    The master is its own quadratic edges made C¹ through their corners
+    (:data:`~.segments.SMOOTH_EDGE`), which keeps their consistent loads; on the Catmull–Rom
+    curve of the other contacts (``smooth_edges=False``) every master node takes the same share
+    of a uniform pressure, the master's corners are pressed in and its surface grows the
+    corner/midside sawtooth of nodal contact (rms second difference 7–9e-4 R at h/R 0.05 on the
+    E-ratio-3 band pair, the slave's 1e-4 R; Newton stalls there). On the smooth master the
+    split of near-equal bodies runs away towards the master (:data:`SEGMENT_PAIR_WARNING`).
     """
 
     def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 2,
@@ -583,6 +581,7 @@ class TwoBodySolver(CycleLegs):
                 self.passes = [ContactPass(self.slave, self.master, self.n_dofs, 0.5),
                                ContactPass(self.master, self.slave, self.n_dofs, 0.5)]
             elif self.options.segment_scheme == "mortar":  # one pass, the softer body's weighted gaps
+                warnings.warn(SEGMENT_PAIR_WARNING, SegmentPairWarning, stacklevel=2)
                 self.slave_index = slave_index(material1, radius1, material2, radius2)
                 self.slave, self.master = self.bodies[self.slave_index], self.bodies[1 - self.slave_index]
                 self.passes = [MortarContactPass(self.slave, self.master, self.n_dofs, 1.0, n_gauss)]
