@@ -67,7 +67,7 @@ verify-pair-speed: $(STAMP)
 verify-pair-surface: $(STAMP)
 	$(PY) -m spherecontact.fem.pair_surface --db data/reference_v2.h5 data/reference.h5 --out reports/fem
 
-# the equal-hardness pairs' split under nodal, Gauss-point and mortar contact (~30 min)
+# the equal-hardness pairs' split under nodal, Gauss-point and mortar contact (~35 min)
 verify-pair-contacts: $(STAMP)
 	$(PY) -m spherecontact.fem.pair_contacts --out reports/fem
 

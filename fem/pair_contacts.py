@@ -10,15 +10,17 @@ pairs"). Each scene is run with the approach-scaled penalty (P = 3000, no cycles
 * ``mortar``: one pass of the softer body's weighted gaps (``segment_scheme`` "mortar",
   2 points per half edge; :class:`~.twobody.MortarContactPass`);
 * ``mortar, other slave``: the same with the other body's weighted gaps;
-* ``mortar, two passes``: both bodies' weighted gaps in turn, half the stiffness each.
+* ``mortar, Catmull-Rom master``: the softer body's weighted gaps against the Catmull–Rom curve
+  of the other contacts instead of the master's own edges made C¹ (``segments.SMOOTH_EDGE``).
 
-One-pass mortar is the discretisation whose answer must not depend on which body is the slave;
-where its two slave choices agree, that is the split the others are read against. Recorded per
+The scenes: campaign v1's pairs E₂ = 3E₁ and R₂ = 2R₁ on the surface band, and two equal-radius
+pairs on the default mesh, E₂ = 1.05 E₁ and identical spheres. One-pass mortar's answer must not
+depend on which body is the slave; where it does, the split is ill-conditioned. Recorded per
 run: status, end, wall time, h₁/h and F at ``APPROACHES``, and the corner/midside sawtooth of
 both final surfaces (:func:`~.pair_surface.final_surfaces`).
 
 ``python -m spherecontact.fem.pair_contacts --out reports/fem`` → ``split_contacts.json``
-(about 30 min on two cores).
+(about 35 min on two cores).
 """
 
 from __future__ import annotations
