@@ -294,8 +294,9 @@ def _add_numerics(add) -> None:
              "bodies: symmetric two-pass, with E* of the pair); the default is exact contact "
              "(Lagrange multipliers)")
     add(grp, "--segment-points", type=int, default=0,
-        help="with --penalty (one body on a rigid flat or sphere): integrate the contact pressure "
-             "at this many Gauss points per surface edge, 1-64 (default 0: at the nodes)")
+        help="with --penalty: integrate the contact pressure at this many Gauss points per surface "
+             "edge, 1-64 (default 0: at the nodes); two bodies: see --segment-scheme, and the split "
+             "of spheres of equal yield stress is unstable with smooth surfaces (README)")
     add(grp, "--segment-scheme", choices=SEGMENT_SCHEMES, default=_DEFAULTS.segment_scheme,
         help="two bodies with --segment-points: 'points' (default; each Gauss point its own "
              "penalty, both bodies in turn) or 'mortar' (one pass of the softer body's weighted "
