@@ -296,7 +296,7 @@ def _add_numerics(add) -> None:
     add(grp, "--segment-points", type=int, default=0,
         help="with --penalty: integrate the contact pressure at this many Gauss points per surface "
              "edge, 1-64 (default 0: at the nodes); two bodies: see --segment-scheme, and the split "
-             "of spheres of equal yield stress is unstable with smooth surfaces (README)")
+             "of spheres of equal yield stress is nearly neutral with smooth surfaces (README)")
     add(grp, "--segment-scheme", choices=SEGMENT_SCHEMES, default=_DEFAULTS.segment_scheme,
         help="two bodies with --segment-points: 'points' (default; each Gauss point its own "
              "penalty, both bodies in turn) or 'mortar' (one pass of the softer body's weighted "
