@@ -96,7 +96,7 @@ def run_one(scene: Scene, contact: str) -> dict:
     h, F, h1 = (np.asarray(res.curves[k], dtype=float) for k in ("h", "F", "h1"))
     at = [x for x in APPROACHES if x <= h[-1] * (1 + 1e-3)]  # h_max itself, reached to round-off
     return {"scene": scene.name, "contact": contact, "status": res.status, "reason": res.reason,
-            "h_end": float(h[-1]), "wall_s": wall, "slave": 1 if s.slave is s.bodies[0] else 2,
+            "h_end": float(h[-1]), "wall_s": wall, "slave": res.inputs["slave_body"],
             "approaches": at, "split": [float(np.interp(x, h, h1 / h)) for x in at],
             "F": [float(np.interp(x, h, F)) for x in at],
             "surfaces": final_surfaces(s, res.final["X"], res.final["u"], float(np.max(res.a)))}

@@ -410,12 +410,15 @@ class SegmentContactPass(ContactPass):
     closes then takes its pressure edge point by edge point, not at once as a nodal ring.
     """
 
-    def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 4):
+    def __init__(self, slave: Body, master: Body, n_dofs: int, weight: float = 1.0, n_gauss: int = 4,
+                 halves: bool = False):
         super().__init__(slave, master, n_dofs, weight)
         arc = slave.hmesh.surface
-        edges, N, area, r0 = edge_gauss_points(slave.hmesh.X[:, arc], n_gauss)
+        edges, N, area, r0 = edge_gauss_points(slave.hmesh.X[:, arc], n_gauss, halves=halves)
         edges, area, r0 = edges[:-1], area[:-1], r0[:-1]  # all edges but the equator's
-        self.point_nodes = np.repeat(arc[edges].T, n_gauss, axis=1)  # (3, e·q), edge by edge
+        #: arc position (3, e·q) of the slave nodes each point interpolates, edge by edge
+        self.point_arc = np.repeat(edges.T, N.shape[1], axis=1)
+        self.point_nodes = arc[self.point_arc]
         self.point_weights = np.tile(N, (1, edges.shape[0]))
         self.area0, self.r0 = area.ravel(), r0.ravel()
 
@@ -474,20 +477,13 @@ class MortarContactPass(SegmentContactPass):
                  smooth_edges: bool = True):
         if smooth_edges:
             self.basis = SMOOTH_EDGE
-        ContactPass.__init__(self, slave, master, n_dofs, weight)
-        arc = slave.hmesh.surface
-        edges, N, area, r0 = edge_gauss_points(slave.hmesh.X[:, arc], n_gauss, halves=True)
-        edges, area, r0 = edges[:-1], area[:-1], r0[:-1]  # all edges but the equator's
-        q = N.shape[1]
-        self.point_nodes = np.repeat(arc[edges].T, q, axis=1)  # (3, e·q), edge by edge
-        self.point_weights = np.tile(N, (1, edges.shape[0]))
-        self.area0, self.r0 = area.ravel(), r0.ravel()
-        xi = N[2] - N[0]
+        super().__init__(slave, master, n_dofs, weight, n_gauss, halves=True)
+        xi = self.point_weights[2] - self.point_weights[0]  # N₂ − N₀ = ξ
         hat = np.stack([np.maximum(-xi, 0.0), 1.0 - np.abs(xi), np.maximum(xi, 0.0)])
-        pos = np.repeat(edges.T, q, axis=1)  # (3, points): arc position of each node
+        pos = self.point_arc
         cols = np.broadcast_to(np.arange(pos.shape[1]), pos.shape)
-        raw = sp.csr_matrix(((np.tile(hat, (1, edges.shape[0])) * self.area0).ravel(),
-                             (pos.ravel(), cols.ravel())), shape=(self.candidates.size, pos.shape[1]))
+        raw = sp.csr_matrix(((hat * self.area0).ravel(), (pos.ravel(), cols.ravel())),
+                            shape=(self.candidates.size, pos.shape[1]))
         raw.eliminate_zeros()
         #: reference area of each slave node's hat (0 where no edge point reaches it)
         self.node_area = np.asarray(raw.sum(axis=1)).ravel()
@@ -568,10 +564,8 @@ class TwoBodySolver(CycleLegs):
                        Body(material2, float(radius2), discs[1], discs[0].n_dofs, True)]
         self.n_dofs = sum(b.n_dofs for b in self.bodies)
         self.R = min(radius1, radius2)
-        self.slave_index = slave_index(material1, radius1, material2, radius2,
-                                       two_pass=self.options.penalty is not None)
-        self.slave = self.bodies[self.slave_index]
-        self.master = self.bodies[1 - self.slave_index]
+        i = slave_index(material1, radius1, material2, radius2, two_pass=self.options.penalty is not None)
+        self.slave, self.master = self.bodies[i], self.bodies[1 - i]
         self.k_penalty = None
         if self.options.penalty is None:
             self.passes = [ContactPass(self.slave, self.master, self.n_dofs)]
@@ -583,8 +577,8 @@ class TwoBodySolver(CycleLegs):
                                ContactPass(self.master, self.slave, self.n_dofs, 0.5)]
             elif self.options.segment_scheme == "mortar":  # one pass, the softer body's weighted gaps
                 warnings.warn(SEGMENT_PAIR_WARNING, SegmentPairWarning, stacklevel=2)
-                self.slave_index = slave_index(material1, radius1, material2, radius2)
-                self.slave, self.master = self.bodies[self.slave_index], self.bodies[1 - self.slave_index]
+                i = slave_index(material1, radius1, material2, radius2)
+                self.slave, self.master = self.bodies[i], self.bodies[1 - i]
                 self.passes = [MortarContactPass(self.slave, self.master, self.n_dofs, 1.0, n_gauss)]
             else:
                 warnings.warn(SEGMENT_PAIR_WARNING, SegmentPairWarning, stacklevel=2)
@@ -1133,7 +1127,7 @@ class TwoBodySolver(CycleLegs):
                   "mesh_density": b1.hmesh.density, "edge_band": b1.hmesh.edge_band,
                   "band_floor": b1.hmesh.band_floor, "element": b1.disc.element,
                   "n_elements": b1.disc.n_elements + b2.disc.n_elements, "n_dofs": self.n_dofs,
-                  "slave_body": self.slave_index + 1, "options": self.options.as_inputs()}
+                  "slave_body": 1 if self.slave is b1 else 2, "options": self.options.as_inputs()}
         return RunResult(inputs=inputs, curves=curves, residuals=residuals,
                          profile_r=np.array(prof_r).reshape(-1, n), profile_p=np.array(prof_p).reshape(-1, n),
                          profile_g=np.array(prof_g).reshape(-1, n), status=status, reason=reason,
