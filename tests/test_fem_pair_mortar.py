@@ -24,7 +24,7 @@ def _pressed(options: SolverOptions, h: float = 2e-3):
 
 
 def test_mortar_is_one_pass_of_the_softer_body_on_the_growing_pattern():
-    """... and warns that the split of near-equal bodies is nearly neutral with smooth surfaces."""
+    """... and warns that it biases the split of near-equal bodies towards the master."""
     with pytest.warns(SegmentPairWarning, match="split"):
         TwoBodySolver(SOFT, 1.0, STIFF, 2.0, options=SolverOptions(penalty=100.0, segment_points=2,
                                                                   segment_scheme="mortar"))
