@@ -333,7 +333,7 @@ def _unloading(d: dict) -> dict:
 
 def _interface(d: dict) -> dict:
     """The optional ``interface`` section as ``Coefficients`` fields (absent: no coupling)."""
-    values = _ranged(d, "interface", _INTERFACE_RANGES)
+    values = _ranged(d, "interface", _INTERFACE_RANGES, optional=("radius", "exponent"))
     return {} if values is None else {f"interface_{k}": v for k, v in values.items()}
 
 
@@ -695,11 +695,11 @@ class Coefficients:
     counter_H_bar_conformity: float = 0.0
     counter_c2_conformity: float = 0.0
     #: two-body interface equation (``unified.py``): coupling λ (0: equal mean pressures alone),
-    #: similarity width δ of the fully plastic pressures, and the contact radius a_c/R* and
-    #: exponent k of the anchor's move from the Hertz partition to equal strains
+    #: similarity width δ of the fully plastic pressures; the anchor is the Hertz partition, or
+    #: with a finite contact radius a_c/R* it moves from there to equal strains with exponent k
     interface_coupling: float = 0.0
     interface_similarity: float = 0.2
-    interface_radius: float = 1.0
+    interface_radius: float = math.inf
     interface_exponent: float = 4.0
     #: the rigid partner's cap in h: "paraboloid" (a²/(2ρ) alone) or "exact" (``cap.py``)
     counter_cap: str = "paraboloid"
@@ -882,8 +882,8 @@ class Coefficients:
             **({"strain_spread": self.strain_spread} if self.strain_spread else {}),
             **({"interface": {"coupling": self.interface_coupling,
                               "similarity": self.interface_similarity,
-                              "radius": self.interface_radius,
-                              "exponent": self.interface_exponent}}
+                              **({"radius": self.interface_radius, "exponent": self.interface_exponent}
+                                 if math.isfinite(self.interface_radius) else {})}}
                if self.interface_coupling else {}),
             **({"counter_surface": self._counter_section()} if self.has_counter_surface else {}),
             **({"counter_cap": self.counter_cap} if self.counter_cap != "paraboloid" else {}),

@@ -11,7 +11,7 @@ import pytest
 from spherecontact.model import Material, Sphere, load_coefficients
 from spherecontact.model.cap import T_CONTINUE, cap_excess_factor, cap_gap_factor
 from spherecontact.model.coefficients import Coefficients
-from spherecontact.model.unified import UnifiedPair
+from spherecontact.model.unified import UnifiedPair, harder_partner_weight
 
 CO = load_coefficients()
 EXACT = CO if CO.counter_cap == "exact" else CO.replace(counter_cap="exact")
@@ -81,11 +81,21 @@ def test_a_much_harder_partner_deepens_the_softer_body_only():
         fm = f(pe._two_body_state(a * math.exp(-e), um)[0])
         slope = se.dlnh_dlna if name == "h" else se.dlnh1_dlna
         np.testing.assert_allclose((np.log(fp) - np.log(fm)) / (2 * e), slope, rtol=1e-5, err_msg=name)
-    # equal yield stresses: no weight, the paraboloid split to the bit
-    s2e = Sphere(0.33, Material(E=900.0, nu=0.3, sigma_y=1.0))
+    # equal yield stresses and moduli: no weight, the paraboloid split to the bit; equal yield
+    # stresses and a stiffer partner: the stiffer is the harder (``harder_partner_weight``)
     a2 = np.geomspace(0.01, 0.2, 9)
+    s2e = Sphere(0.33, Material(E=500.0, nu=0.3, sigma_y=1.0))
+    assert harder_partner_weight(s1, s2e) == harder_partner_weight(s2e, s1) == 0.0
     assert np.array_equal(UnifiedPair(s1, s2e, EXACT).state_at_a(a2).h,
                           UnifiedPair(s1, s2e, PARABOLOID).state_at_a(a2).h)
+    stiff = Sphere(0.33, Material(E=900.0, nu=0.3, sigma_y=1.0))
+    assert harder_partner_weight(s1, stiff) > 0.8 and harder_partner_weight(stiff, s1) == 0.0
+    se2, sp2 = UnifiedPair(s1, stiff, EXACT).state_at_a(a2), UnifiedPair(s1, stiff, PARABOLOID).state_at_a(a2)
+    assert np.all(se2.h1 > sp2.h1)
+    # a yield ratio of 1.5 decides alone: a partner of lower yield stress is no harder, whatever its
+    # modulus
+    soft_y = Sphere(0.33, Material(E=5000.0, nu=0.3, sigma_y=1.0 / 1.5))
+    assert harder_partner_weight(s1, soft_y) == 0.0 and harder_partner_weight(soft_y, s1) > 0.5
 
 
 def test_counter_cap_key_round_trips_and_names_bad_values():

@@ -40,18 +40,21 @@ BEFORE = {
                    -0.07909476493751305],
 }
 #: contact() of Sphere(1, HARD) with Sphere(2, E/σY = 100) at h = 1e-3, 0.03, 0.2, same set.
-#: Body 2 has the curvature ratio z_2 = R_2 E*/(E'_2 R*) − 1 = 1.5, beyond the default calibrated
-#: z ≤ 1, where the z-terms of the collapse limits are now continued to constants (levels.py):
-#: these numbers hold for a set whose range covers z = 1.5 (``_z_covered``), the default set
-#: gives ``CONTINUED_F``, ``CONTINUED_K``.
-BEFORE_F = [0.0035416949668974477, 0.4283235128640877, 2.468586948384369]
-BEFORE_K = [6.184792990601234, 16.419257857555962, 10.388601035535771]
-CONTINUED_F = [0.0035421038534381214, 0.4279919740293698, 2.460924697535708]
-CONTINUED_K = [6.185707841542298, 16.393051939792855, 10.344408291010966]
+#: The yield stresses are equal and HARD has five times the modulus, so since 2026-11-28 body 2
+#: sees it as a rigid sphere of its radius (``unified.harder_partner_weight``, w = 0.997):
+#: curvature ratio z_2 = 2.0 (it was z_2 = R_2 E*/(E'_2 R*) − 1 = 1.5 at the Hertz partition, F
+#: 0.428 / 2.469 at h = 0.03 / 0.2 then), beyond the default calibrated z ≤ 1, where the z-terms
+#: of the collapse limits are continued to constants (levels.py): these numbers hold for a set
+#: whose range covers z = 2 (``_z_covered``), the default set gives ``CONTINUED_F``,
+#: ``CONTINUED_K``.
+BEFORE_F = [0.0035406208135961878, 0.43227073150778006, 2.531441568399702]
+BEFORE_K = [6.182958386268945, 16.682775575721227, 10.754554212361166]
+CONTINUED_F = [0.0035420639657804684, 0.43206427256760727, 2.516628200343591]
+CONTINUED_K = [6.186364056083501, 16.65145196474727, 10.668244819759849]
 
 
 def _z_covered(co: Coefficients) -> Coefficients:
-    """``co`` with the default calibrated range but R/R_rigid up to 2 (z ≤ 1.5 as fitted)."""
+    """``co`` with the default calibrated range but R/R_rigid up to 2 (z ≤ 2)."""
     d = co.to_dict()
     d["provenance"]["calibrated_range"] = dict(DEFAULT_RANGE.to_dict(), R_over_R_rigid=[0.0, 2.0])
     return Coefficients.from_dict(d)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from spherecontact.calibration.interface import EXPONENTS, RADII, PairCurve, fit_interface
+from spherecontact.calibration.interface import COUPLINGS, PairCurve, fit_interface
 from spherecontact.model import ContactLaw, Material, Sphere, contact, load_coefficients
 from spherecontact.model.coefficients import Coefficients
 
@@ -23,17 +23,32 @@ def _split(s1, s2, co, h=H):
     return st.h1 / h, st
 
 
-def test_equal_yield_split_no_longer_runs_away():
-    # EPP E/σY 300 against 900 (FE: 0.75 elastic, 0.55 at h/R = 0.3): equal pressures alone put
-    # nearly all of the approach into the softer sphere; the calibrated interface terms keep it
-    # near the FE
+def test_equal_yield_split_follows_the_smooth_contact_fe_and_stays_unique():
+    # EPP E/σY 300 against 900 (FE with smooth frictionless contact: 0.75 elastic, 0.91 at
+    # h/R = 0.1, 0.96 at 0.3): equal pressures alone overshoot early (0.95 at h/R 0.09); the
+    # calibrated weak pull to the Hertz partition keeps the split rising, below that
     s1, s2 = Sphere(1.0, SOFT), Sphere(1.0, STIFF)
-    assert BASE.interface_coupling > 0.0
+    assert 0.0 < BASE.interface_coupling < 1.0 and math.isinf(BASE.interface_radius)
+    assert "radius" not in BASE.to_dict()["interface"]
     without, _ = _split(s1, s2, dataclasses.replace(BASE, interface_coupling=0.0))
     with_, _ = _split(s1, s2, BASE)
     assert without[-1] > 0.95
-    assert 0.5 < with_[-1] < 0.65
+    assert 0.85 < with_[-1] < without[-1]
+    assert np.all(np.diff(with_[H > 3e-3]) > 0)  # moves one way, towards the softer sphere
     assert np.all(np.abs(with_[H < 0.003] - 0.75) < 0.02)  # the elastic partition while contained
+
+
+def test_the_check_along_h_catches_the_ill_posed_pair_and_the_coupling_mends_it():
+    """E/σY 3·10⁴ against 150 at equal yield stress, R₂ = 2R₁ (a pair of the check's grid): with
+    equal pressures alone F(h) falls steeply where the κ root jumps (the sweep in a alone saw a
+    rise there); the calibrated coupling passes both sweeps."""
+    from spherecontact.calibration.check import check_pair, two_body_pairs
+
+    (label, s1, s2), = [p for p in two_body_pairs() if p[0].startswith("E/sy=30000 vs E/sy=150 ")]
+    bad = check_pair(label, s1, s2, dataclasses.replace(BASE, interface_coupling=0.0))
+    assert not bad.ok and bad.min_dlnF_h < 0.0
+    good = check_pair(label, s1, s2, BASE)
+    assert good.ok and good.min_dlnF_h > 0.2
 
 
 @pytest.mark.parametrize("pair", ["elastic", "equal_material_radii_2", "yield_ratio_1.5",
@@ -88,6 +103,7 @@ def test_coefficient_file_round_trip_and_bad_values():
     d = CO.to_dict()
     assert d["interface"] == {"coupling": 10.0, "similarity": 0.1, "radius": 0.8, "exponent": 6.0}
     assert Coefficients.from_dict(d) == CO
+    assert Coefficients.from_dict(BASE.to_dict()) == BASE  # the Hertz anchor: no radius written
     assert "interface" not in dataclasses.replace(CO, interface_coupling=0.0).to_dict()
     older = {k: v for k, v in d.items() if k != "interface"}
     assert Coefficients.from_dict(older).interface_coupling == 0.0  # older files read
@@ -98,9 +114,7 @@ def test_coefficient_file_round_trip_and_bad_values():
             Coefficients.from_dict(dd)
 
 
-def test_grid_search_recovers_the_anchor_it_was_given():
-    # synthetic "FE" splits made by the model with a known anchor: the fit finds it again
-    truth = dataclasses.replace(CO, interface_radius=RADII[3], interface_exponent=EXPONENTS[1])
+def _synthetic_pairs(truth):
     pairs = []
     softer = Sphere(1.0, Material(E=99.9, nu=0.3, sigma_y=1.0))
     for name, s2 in (("stiffer", Sphere(1.0, STIFF)), ("softer", softer)):
@@ -108,15 +122,42 @@ def test_grid_search_recovers_the_anchor_it_was_given():
         h = np.geomspace(3e-3, 0.3, 30)
         split, _ = _split(s1, s2, truth, h)
         pairs.append(PairCurve(name, s1, s2, h, split))
-    f = fit_interface(pairs, dataclasses.replace(CO, interface_coupling=0.0))
-    assert (f.radius, f.exponent) == (RADII[3], EXPONENTS[1])
+    return pairs
+
+
+def test_grid_search_recovers_the_coupling_it_was_given():
+    # synthetic "FE" splits made by the model with a known coupling: the fit finds it again
+    truth = dataclasses.replace(BASE, interface_coupling=COUPLINGS[4], interface_similarity=0.1,
+                                interface_radius=math.inf)
+    pairs = _synthetic_pairs(truth)
+    off = dataclasses.replace(BASE, interface_coupling=0.0)
+    f = fit_interface(pairs, off, check=None)
+    assert f.coupling == COUPLINGS[4] and f.section() == {"coupling": COUPLINGS[4], "similarity": 0.1}
     assert max(f.errors.values()) < 1e-9 < min(f.errors_none.values())
+    assert [lam for lam, _, _ in f.tried][0] == COUPLINGS[4] and len(f.tried) == len(COUPLINGS)
     # the grid spread over two worker processes gives the same fit, error for error
     from spherecontact.calibration.workers import Workers
 
     with Workers(None, 2) as pool:
-        g = fit_interface(pairs, dataclasses.replace(CO, interface_coupling=0.0), pool)
-    assert (g.radius, g.exponent, g.errors, g.errors_none) == (f.radius, f.exponent, f.errors, f.errors_none)
+        g = fit_interface(pairs, off, pool, check=None)
+    assert (g.coupling, g.errors, g.errors_none, g.tried) == (f.coupling, f.errors, f.errors_none, f.tried)
+
+
+def test_a_coupling_whose_model_fails_the_check_is_passed_over():
+    truth = dataclasses.replace(BASE, interface_coupling=COUPLINGS[4], interface_similarity=0.1,
+                                interface_radius=math.inf)
+    pairs = _synthetic_pairs(truth)
+    seen = []
+
+    def check(co):  # refuses the best coupling
+        seen.append(co.interface_coupling)
+        return co.interface_coupling != COUPLINGS[4]
+
+    f = fit_interface(pairs, dataclasses.replace(BASE, interface_coupling=0.0), check=check)
+    assert seen[:2] == [COUPLINGS[4], f.coupling] and f.coupling != COUPLINGS[4]
+    assert f.tried[0] == (COUPLINGS[4], pytest.approx(0.0, abs=1e-9), False)
+    assert f.tried[1][2] is True and all(ok is None for _, _, ok in f.tried[2:])
+    assert max(f.errors.values()) > 0.0
 
 
 def test_pairs_of_clearly_unequal_hardness_skip_the_coupling():
