@@ -645,36 +645,45 @@ class UnifiedPair:
             return Domain(2.0 * R, float(self._invert(np.array([2.0 * R]))[0][0]), self._own_text(i, R))
         return self._general_domain(own)
 
-    def _own_ratio(self, a, own) -> np.ndarray:
-        """max_i h_i/R_i over the deformable spheres ``own`` at contact radii a (general mode)."""
-        st = self.state_at_a(a)
+    def _own_ratio(self, a, own, u_guess=None) -> tuple[np.ndarray, np.ndarray]:
+        """max_i h_i/R_i over the deformable spheres ``own`` at contact radii a (general mode),
+        and the κ roots u there (``u_guess``: where their solve starts)."""
+        u = self.solve_u(a, u_guess)
+        st = self.state_at_a(a, u)
         h_i = {1: st.h1, 2: st.h2}
-        return np.maximum.reduce([h_i[i] / R for i, R in own] + [np.zeros_like(a)])
+        return np.maximum.reduce([h_i[i] / R for i, R in own] + [np.zeros_like(a)]), u
 
     def _general_domain(self, own) -> Domain:
         """The domain of two deformable spheres: the smallest a with max_i h_i/R_i = 1 (a scan
         in ln a, then :meth:`_refine_crossing`)."""
         t = math.log(self.R_star) + np.arange(-14.0, 7.0, 0.1)
-        above = np.nonzero(self._own_ratio(np.exp(t), own) >= 1.0)[0]
+        ratio, u = self._own_ratio(np.exp(t), own)
+        above = np.nonzero(ratio >= 1.0)[0]
         if above.size == 0:
             return Domain(math.inf, math.inf, "")
         j = above[0]
-        a = math.exp(self._refine_crossing(t[max(j - 1, 0)], t[j], own))
+        i = max(j - 1, 0)
+        a = math.exp(self._refine_crossing(t[i], t[j], own, (t[i], u[i]), (t[j], u[j])))
         st = self.state_at_a(np.array([a]))
         h_i = {1: float(st.h1[0]), 2: float(st.h2[0])}
         k, R = max(own, key=lambda c: h_i[c[0]] / c[1])
         return Domain(float(st.h[0]), a, self._own_text(k, R))
 
-    def _refine_crossing(self, lo: float, hi: float, own) -> float:
+    def _refine_crossing(self, lo: float, hi: float, own, at_lo, at_hi) -> float:
         """ln a where max_i h_i/R_i first reaches 1 in [lo, hi] (multi-section passes, one
-        vectorised κ solve each); returns the upper end (≥ 1 side)."""
+        vectorised κ solve each, started from u interpolated between the roots ``at_lo``,
+        ``at_hi`` = (ln a, u) at the ends); returns the upper end (≥ 1 side)."""
         frac = np.arange(1, _DOMAIN_SECTIONS) / _DOMAIN_SECTIONS
         for _ in range(_DOMAIN_PASSES):
             pts = lo + (hi - lo) * frac
-            k = np.nonzero(self._own_ratio(np.exp(pts), own) >= 1.0)[0]
+            guess = np.interp(pts, (at_lo[0], at_hi[0]), (at_lo[1], at_hi[1]))
+            ratio, u = self._own_ratio(np.exp(pts), own, guess)
+            k = np.nonzero(ratio >= 1.0)[0]
             first = k[0] if k.size else frac.size
-            lo = pts[first - 1] if first > 0 else lo
-            hi = pts[first] if first < frac.size else hi
+            if first > 0:
+                lo, at_lo = pts[first - 1], (pts[first - 1], u[first - 1])
+            if first < frac.size:
+                hi, at_hi = pts[first], (pts[first], u[first])
         return float(hi)
 
     @staticmethod
