@@ -8,7 +8,7 @@ surfaces (campaign v2's E/σY 300 against 900 and 99.9, Gauss-point contact sinc
 2026-11-28) moves the split from the Hertz partition towards the softer sphere, 0.75 → 0.96
 at h/R = 0.3, converged under mesh refinement; equal pressures alone overshoot early (6 points
 at h/R 0.06) and leave the κ root of extreme pairs not unique (E/σY 3·10⁴ against 150,
-R₂ = 2R₁: the inversion raises; ``check.py``).
+R₂ = 2R₁: F(h) falls where the root jumps, d ln F/d ln h −19; ``check.py``).
 
 Fixed: the anchor, the Hertz partition u_H = ln(E'₂/E'₁) at every contact radius (a weak
 pull, not a course to follow), and the similarity width δ = ``SIMILARITY`` of the fully

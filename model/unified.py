@@ -21,7 +21,7 @@ with smooth frictionless contact surfaces follows it: two EPP spheres of equal �
 3 move from the Hertz partition h_1/h = 0.75 to 0.96 at h/R = 0.3, converged under mesh
 refinement (``calibration/interface.py``). Equal pressures alone overshoot early (6 points at
 h/R 0.06) and, for extreme pairs, lose the uniqueness of the root (E/σY 3·10⁴ against 150,
-R_2 = 2R_1: the inversion fails). The interface equation is therefore
+R_2 = 2R_1: F(h) falls where the root jumps). The interface equation is therefore
 
     g(u) = ln p_1 − ln p_2 + C(a) (u − u_A(a)) = 0,
     C = λ f_E s_1 s_2 exp(−(ln(P_1/P_2)/δ)²),   u_A = u_H/(1 + (a/(a_c R*))^k),
