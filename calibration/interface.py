@@ -189,15 +189,15 @@ def fit_interface(pairs, coeffs: Coefficients, pool=None, check=passes_check) ->
     if not pairs:
         return None
     none = pair_errors(pairs, _with(coeffs, 0.0))
-    probe = pair_errors(pairs, _with(coeffs, COUPLINGS[-1]))
-    moved = [c for c in pairs if probe[c.name] != none[c.name]]
+    strongest = pair_errors(pairs, _with(coeffs, COUPLINGS[-1]))  # also the probe of which pairs move
+    moved = [c for c in pairs if strongest[c.name] != none[c.name]]
     fixed = {c.name: none[c.name] for c in pairs if c not in moved}
-    lams = [lam for lam in COUPLINGS if lam > 0.0]
+    lams = [lam for lam in COUPLINGS if 0.0 < lam < COUPLINGS[-1]]
     tasks = [(moved, coeffs, lam) for lam in lams]
     done = pool.map(_grid_point, tasks) if pool is not None else [_grid_point(None, *t) for t in tasks]
     scored = []
-    for lam, moved_errors in zip([0.0, *lams], [{}, *done], strict=True):
-        e = none if lam == 0.0 else fixed | moved_errors
+    for lam, e in zip([0.0, *lams, COUPLINGS[-1]], [none, *(fixed | d for d in done), strongest],
+                      strict=True):
         e = {c.name: e[c.name] for c in pairs}
         ratios = [target_ratio(v) for v in e.values()]
         worst = max(ratios)

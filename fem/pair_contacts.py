@@ -111,7 +111,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--mesh-density", type=float, default=1.0,
                     help="mesh density (2: every size halved); not 1: written to "
-                         "split_contacts_density<D>.json")
+                         "split_contacts_density<D>.json (at 1, a subset of scenes or contacts "
+                         "goes to split_contacts_subset.json, the full report is kept)")
     ap.add_argument("--scenes", help="comma-separated scene names (default: all), e.g. 'E2 = 3 E1'")
     ap.add_argument("--contacts", help=f"comma-separated contacts (default: all of {', '.join(CONTACTS)})")
     args = ap.parse_args(argv)
@@ -138,8 +139,9 @@ def main(argv: list[str] | None = None) -> int:
     rows.sort(key=lambda r: order[(r["scene"], r["contact"])])
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    name = "split_contacts.json" if args.mesh_density == 1.0 else \
-        f"split_contacts_density{args.mesh_density:g}.json"
+    subset = len(jobs) < len(SCENES) * len(CONTACTS)
+    name = ("split_contacts" + (f"_density{args.mesh_density:g}" if args.mesh_density != 1.0 else
+                                "_subset" if subset else "") + ".json")
     (out / name).write_text(json.dumps(rows, indent=1) + "\n")
     return 0
 

@@ -33,10 +33,10 @@ where both bodies are plastic and their fully plastic pressures are within about
 other (the ill-conditioned case), and only where their moduli differ (f_E: the neutral drift
 is driven by the E-dependence of H̄(Λ) in Level II; equal materials of unequal radii keep the
 equal-pressure split). The calibrated anchor is the Hertz partition itself (a_c = ∞, u_A =
-u_H), a weak pull (λ of order 0.1) that keeps the root unique; a finite a_c moves the anchor
-to equal strains x_1 = x_2 (u = 0) as the contact deepens (files before 2026-11-28, fitted to
-nodal-contact FE whose interlocked surfaces held the split). C and u_A do not depend on
-u, so g still rises with u and the root is unique; C = 0 while either body is elastic or in
+u_H), a weak pull (λ = 0.01 in the file of 2026-11-28) that keeps the root unique; a finite
+a_c moves the anchor to equal strains x_1 = x_2 (u = 0) as the contact deepens (files before
+2026-11-28, fitted to nodal-contact FE whose interlocked surfaces held the split). C and u_A do
+not depend on u, so g still rises with u and the root is unique; C = 0 while either body is elastic or in
 Level I (the Hertz split stays exact), and equal materials (u_H = 0) are left alone. The
 contact pressure is then √(p_1 p_2) (p_1 = p_2 for λ = 0).
 
