@@ -156,6 +156,11 @@ def main() -> dict:
 
 #: a copper alloy for the setup survey (Ludwik, SI units)
 COPPER = Material(E=120e9, nu=0.34, sigma_y=70e6, K=300e6, n=0.4)
+#: two perfectly plastic spheres of equal yield stress and E ratio 3 (E/σY 300 and 900, the
+#: calibration pair two-pp-E300-nu0.3-vs-E900): the harder partner is decided by the modulus and
+#: the interface terms are active, the slowest setup class measured
+SOFT_EQUAL_YIELD = Material(E=300 * 100e6, nu=0.3, sigma_y=100e6)
+STIFF_EQUAL_YIELD = Material(E=900 * 100e6, nu=0.3, sigma_y=100e6)
 
 
 def setup_by_pair(co) -> dict:
@@ -166,7 +171,8 @@ def setup_by_pair(co) -> dict:
              "steel R / aluminium R": (Sphere(R, STEEL), Sphere(R, ALU)),
              "steel 2R / aluminium R": (Sphere(2 * R, STEEL), Sphere(R, ALU)),
              "copper R / aluminium R": (Sphere(R, COPPER), Sphere(R, ALU)),
-             "steel R / copper 2R": (Sphere(R, STEEL), Sphere(2 * R, COPPER))}
+             "steel R / copper 2R": (Sphere(R, STEEL), Sphere(2 * R, COPPER)),
+             "equal yield, E ratio 3, R / R": (Sphere(R, SOFT_EQUAL_YIELD), Sphere(R, STIFF_EQUAL_YIELD))}
     out = {}
     for name, pair in pairs.items():
         setups, law = _setups(pair, co)

@@ -14,7 +14,10 @@ percentage points). Against an independent reference: the elastic dissimilar pai
 ``make verify-pair`` (E₂/E₁ = 3, R₂ = 2R₁, ν 0.3 / 0.2, 2× mesh) with the same penalty, F against
 the reference contact radius vs Hertz with E*, R* and h₁/h₂ vs E′₂/E′₁ (its limits: 1 % and 2 %).
 
-``python -m spherecontact.fem.pair_speed --out reports/fem`` → ``approach_pairs.json`` (~4 min).
+``python -m spherecontact.fem.pair_speed --out reports/fem`` → ``approach_pairs.json`` (~4 min);
+``--segment-points 3``: the same with the penalty at 3 Gauss points per edge (two passes, the
+convention of campaign v2's pairs of equal yield stress) → ``approach_pairs_points3.json``. Their
+smooth split differs from the stored nodal runs' by design (README, "Contact").
 """
 
 from __future__ import annotations
@@ -51,12 +54,14 @@ def split_difference(stored: dict, new: dict, h_min: float) -> float:
     return float(np.max(np.abs(mine - np.asarray(stored["h1"])[on] / h[on])))
 
 
-def pair_kwargs(case, penalty: float = PENALTY) -> dict:
-    """The stored pair's run with the approach-scaled penalty, without cycles or a wall limit."""
+def pair_kwargs(case, penalty: float = PENALTY, segment_points: int = 0) -> dict:
+    """The stored pair's run with the approach-scaled penalty (at the nodes, or at
+    ``segment_points`` Gauss points per edge), without cycles or a wall limit."""
     kw = case.run_kwargs()
     kw["unload_at"] = None
     kw["options"] = replace(kw["options"], penalty=penalty, penalty_scale="approach",
-                            linear_solver="cholesky", max_wall_s=math.inf)
+                            linear_solver="cholesky", max_wall_s=math.inf,
+                            segment_points=segment_points)
     return kw
 
 
@@ -74,11 +79,12 @@ def _timed(kw: dict):
     return res, time.perf_counter() - t0
 
 
-def check_case(case, stored, flat_wall: float, penalty: float = PENALTY) -> dict:
-    res, wall = _timed(pair_kwargs(case, penalty))
+def check_case(case, stored, flat_wall: float, penalty: float = PENALTY, segment_points: int = 0) -> dict:
+    res, wall = _timed(pair_kwargs(case, penalty, segment_points))
     R = min(case.inputs["radius"], case.inputs["radius2"])
     cmp = compare_loading(stored.curves, res.curves, 0.01 * R)
-    return {"case": case.name, "penalty": penalty, "status": res.status, "reason": res.reason,
+    return {"case": case.name, "penalty": penalty, "segment_points": segment_points,
+            "status": res.status, "reason": res.reason,
             "h_end": float(res.h[-1]), "wall_s": wall, "increments": res.timings["increments"],
             "newton_iterations": res.timings["newton_iterations"], "n_dofs": res.inputs["n_dofs"],
             "wall_s_stored": float(stored.provenance.get("wall_s", np.nan)),
@@ -86,10 +92,10 @@ def check_case(case, stored, flat_wall: float, penalty: float = PENALTY) -> dict
             "vs_stored": cmp, "split_max": split_difference(stored.curves, res.curves, 0.01 * R)}
 
 
-def hertz_check(penalty: float = PENALTY) -> dict:
+def hertz_check(penalty: float = PENALTY, segment_points: int = 0) -> dict:
     """The elastic pair of ``make verify-pair``'s Hertz check (2× mesh) with the approach-scaled
     penalty, and its figures (``verification_pair.hertz_figures``)."""
-    options = SolverOptions(penalty=penalty, penalty_scale="approach")
+    options = SolverOptions(penalty=penalty, penalty_scale="approach", segment_points=segment_points)
     res, wall = _timed({**HERTZ_PAIR, "density": 2.0, "options": options})
     run = {"curves": res.curves, "wall_s": wall, "n_dofs": res.inputs["n_dofs"]}
     return {"status": res.status, **hertz_figures(run)}
@@ -101,6 +107,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--campaign", default="data/campaign.toml")
     ap.add_argument("--out", default="reports/fem")
     ap.add_argument("--penalty", type=float, default=PENALTY)
+    ap.add_argument("--segment-points", type=int, default=0, choices=range(0, 9), metavar="N",
+                    help="Gauss points per surface edge for the penalty (0: at the nodes; 1-8)")
     args = ap.parse_args(argv)
     db = Database(args.db)
     cases = {c.name: c for c in load_campaign(args.campaign).cases}
@@ -112,7 +120,7 @@ def main(argv: list[str] | None = None) -> int:
         if key not in flats:
             flat, flats[key] = _timed(flat_kwargs(case))
             print(f"body 1 on a flat: {flats[key]:.1f} s ({flat.status})", flush=True)
-        row = check_case(case, db.run(case.key), flats[key], args.penalty)
+        row = check_case(case, db.run(case.key), flats[key], args.penalty, args.segment_points)
         row["wall_s_body1_flat"] = flats[key]
         rows.append(row)
         F, a = row["vs_stored"]["F"], row["vs_stored"]["a"]
@@ -121,13 +129,15 @@ def main(argv: list[str] | None = None) -> int:
               f"F {100 * F['systematic']:+.2f} % (max {100 * F['max']:.2f}, scatter stored "
               f"{100 * F['stored_scatter']:.2f} / new {100 * F['new_scatter']:.2f}), a "
               f"{100 * a['systematic']:+.2f} %, split {100 * row['split_max']:.2f} points", flush=True)
-    hz = hertz_check(args.penalty)
+    hz = hertz_check(args.penalty, args.segment_points)
     print(f"elastic pair vs Hertz (E*, R*): F against a within {hz['F_vs_a_max_pct']:.2f} % (mean "
           f"{hz['F_vs_a_mean_pct']:+.2f} %), h1/h2 within {hz['h1_over_h2_dev_pct_small_h']:.2f} % at "
           f"a/R <= 0.02 ({hz['h1_over_h2_dev_pct_all']:.2f} % over the run)", flush=True)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "approach_pairs.json").write_text(json.dumps({"pairs": rows, "hertz": hz}, indent=1) + "\n")
+    points = args.segment_points
+    name = f"approach_pairs_points{points}.json" if points else "approach_pairs.json"
+    (out / name).write_text(json.dumps({"pairs": rows, "hertz": hz}, indent=1) + "\n")
     return 0
 
 

@@ -43,6 +43,7 @@ from .plasticity import PlasticState, stress_update, tangent
 from .segment_penalty import edge_gauss_points
 from .segments import CATMULL_ROM, SMOOTH_EDGE, gap_gradient, gap_hessian
 from .solver import (
+    LOAD,
     ROUNDOFF,
     CycleLegs,
     IncrementFailed,
@@ -800,7 +801,8 @@ class TwoBodySolver(CycleLegs):
         self._pattern = SimpleNamespace(
             zone=zone, width=width, keys=keys, indptr=indptr, indices=c,
             upper=ConstrainedPattern(indptr, c), body=np.flatnonzero(is_body),
-            diag=np.searchsorted(keys, np.arange(n, dtype=np.int64) * (n + 1)))
+            diag=np.searchsorted(keys, np.arange(n, dtype=np.int64) * (n + 1)),
+            last_keys=None, last_pos=None)  # the contact keys of the last step and where they sit
 
     def _penalty_step(self, K, r, kins, pens, lams) -> np.ndarray:
         """Δu of a penalty Newton iteration: (K + ∂(Gᵀλ)/∂u) Δu = −r on the free dofs, on the
@@ -822,7 +824,10 @@ class TwoBodySolver(CycleLegs):
         normal = np.concatenate([v.ravel() for _, v, _ in blocks])
         curvature = np.concatenate([v.ravel() for _, _, v in blocks])
         pat = self._pattern
-        pos = None if pat is None else np.minimum(np.searchsorted(pat.keys, keys), pat.keys.size - 1)
+        if pat is not None and pat.last_keys is not None and np.array_equal(keys, pat.last_keys):
+            pos = pat.last_pos  # the contact couplings of the last iteration: no search
+        else:
+            pos = None if pat is None else np.minimum(np.searchsorted(pat.keys, keys), pat.keys.size - 1)
         if pat is None or np.any(pat.keys[pos] != keys):
             reach = [p.reach(kin, pen) for p, kin, pen in zip(self.passes, kins, pens, strict=True)]
             zone, width = max(z for z, _ in reach), max(w for _, w in reach)
@@ -830,6 +835,7 @@ class TwoBodySolver(CycleLegs):
             self._fixed_pattern(ZONE_GROWTH * max(zone, zone0), max(width0, width + WINDOW))
             pat = self._pattern
             pos = np.searchsorted(pat.keys, keys)
+        pat.last_keys, pat.last_pos = keys, pos
         data = np.zeros(pat.keys.size)
         data[pat.body] = K.data
         np.add.at(data, pos, normal + curvature)  # a few thousand entries: no pass over the pattern
@@ -990,8 +996,27 @@ class TwoBodySolver(CycleLegs):
 
     @property
     def _step_scale(self) -> float:
-        """1: steps are already in units of the smaller radius (``_length``)."""
-        return 1.0
+        """Segment-integrated contact: 1/f, f ∈ [½, 1] the larger body's share Δh_i/(Δh₁ + Δh₂) of
+        the approach, the larger of the last loading increment's and the whole approach's; the
+        strain step then bounds each body's own step, Δh_i ≤ strain_increment · a, as a body alone
+        on a flat is bounded. Campaign v1's equal-hardness pairs under the Gauss points (P = 3000,
+        approach-scaled): 158 / 151 / 198 increments instead of 202 / 190 / 219 (radius ratio 2 / 4,
+        E ratio 3), F −0.18 / −0.16 / −0.08 % on average from h/R 0.01 to 0.3, FE scatter of F
+        0.97 / 0.60 / 1.30 % against 1.03 / 0.94 / 1.49 %, the split within 0.13 points.
+        Nodal contact: 1. Its E-ratio-3 pair, whose interlocked split is ill-conditioned from
+        h/R 0.2 on, stopped at h/R 0.283 with the per-body step (steps are in units of the
+        smaller radius, ``_length``, already)."""
+        if not isinstance(self.passes[0], SegmentContactPass):
+            return 1.0
+        h1, h2, branch = self._hist.h1, self._hist.h2, self._hist.branch
+        if not h1 or h1[-1] + h2[-1] <= 0.0:
+            return 1.0
+        share = max(h1[-1], h2[-1]) / (h1[-1] + h2[-1])
+        if len(h1) >= 2 and branch[-1] == LOAD:
+            d1, d2 = h1[-1] - h1[-2], h2[-1] - h2[-2]
+            if d1 + d2 > 0.0:
+                share = max(share, max(d1, d2) / (d1 + d2))
+        return 1.0 / min(max(share, 0.5), 1.0)
 
     def _pair_modulus(self) -> float:
         e1, e2 = (b.material.E_prime for b in self.bodies)
