@@ -1,10 +1,14 @@
-"""``spherecontact model curve``: force–approach curve of two spheres from the closed-form model.
+"""``spherecontact model curve`` and ``model table``: the closed-form model from the command line.
 
-A thin layer over :func:`curve`, which tests call directly. Body 2 defaults to a copy
-of body 1 (equal spheres); ``--radius2 inf`` gives a flat, ``--E2 inf`` a rigid body.
-``--unload`` appends the unloading branch from h_max to the residual approach (column
-``branch``: 0 load, 1 unload) and the cycle's residual approach, energies and quasi-static
-restitution coefficient (``cycle.py``).
+``curve``: force–approach curve of two spheres, a thin layer over :func:`curve`, which tests
+call directly. Body 2 defaults to a copy of body 1 (equal spheres); ``--radius2 inf`` gives a
+flat, ``--E2 inf`` a rigid body. ``--unload`` appends the unloading branch from h_max to the
+residual approach (column ``branch``: 0 load, 1 unload) and the cycle's residual approach,
+energies and quasi-static restitution coefficient (``cycle.py``).
+
+``table``: the fast path's table of the pair (``ContactLaw.tables``) as a NumPy ``.npz`` of plain
+arrays, for a particle (DEM) code to evaluate ``force(h, h_max)`` without this package
+(:func:`write_table`).
 """
 
 from __future__ import annotations
@@ -20,10 +24,16 @@ import numpy as np
 from .coefficients import default_coefficients, load_coefficients
 from .contact import contact
 from .cycle import cycle
+from .fast import ContactLaw
 from .material import Material
 from .sphere import Sphere
 
-__all__ = ["register", "curve", "run_curve"]
+__all__ = ["register", "curve", "run_curve", "write_table", "run_table", "TABLE_FORMAT"]
+
+#: format name of the ``model table`` file (its ``meta`` says how to evaluate it)
+TABLE_FORMAT = "spherecontact-contact-table/1"
+#: reference evaluations stored with a table, to check an implementation against
+CHECK_POINTS = 16
 
 COLUMNS = ("h", "F", "a", "h1", "h2", "stiffness")
 
@@ -64,8 +74,8 @@ def curve(s1: Sphere, s2: Sphere, h_max: float, points: int = 50, coeffs=None,
     return data
 
 
-def run_curve(args: argparse.Namespace) -> int:
-    """CLI handler of ``model curve``."""
+def _pair(args: argparse.Namespace) -> tuple[Sphere, Sphere]:
+    """The two spheres of the command line (body 2's missing values are body 1's)."""
     m1 = _material(args.E, args.nu, args.sigma_y, args.K, args.n)
     m2 = _material(
         args.E if args.E2 is None else args.E2,
@@ -75,8 +85,69 @@ def run_curve(args: argparse.Namespace) -> int:
         args.n if args.n2 is None else args.n2,
     )
     s1 = Sphere(radius=args.radius, material=m1)
-    s2 = Sphere(radius=args.radius if args.radius2 is None else args.radius2, material=m2)
-    coeffs = load_coefficients(args.coefficients) if args.coefficients else default_coefficients()
+    return s1, Sphere(radius=args.radius if args.radius2 is None else args.radius2, material=m2)
+
+
+def _coefficients(args: argparse.Namespace):
+    return load_coefficients(args.coefficients) if args.coefficients else default_coefficients()
+
+
+def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs=None) -> dict:
+    """Write the pair's fast-path table to ``path`` (``.npz``) and return what was written.
+
+    Arrays: those of :meth:`ContactLaw.tables` (``ln_h``, ``ln_F_hermite``, ``recovery``, ``m``;
+    the scalars ``h_elastic``, ``h_min``, ``h_max`` as 0-d arrays), the reference evaluations
+    ``check_h``, ``check_h_max``, ``check_F``, ``check_dF_dh`` (``CHECK_POINTS`` loading contacts
+    and as many half way down their peaks' elastic recovery, from ``ContactLaw.force``), and ``meta``: a JSON
+    string with the format name, both bodies, the coefficient source, the table's measured
+    error bounds and the evaluation recipe (the docstring of ``ContactLaw.tables``). Units are
+    those of the inputs.
+    """
+    law = ContactLaw(s1, s2, h_max=h_max, coeffs=coeffs)
+    tab = law.tables()
+    hm = np.geomspace(max(law.h_min, 1e-6 * law.h_max), law.h_max, CHECK_POINTS)
+    s = tab["ln_h"]  # each unloading point half way down its peak's elastic recovery δ_e
+    j = np.clip(np.searchsorted(s, np.log(hm), side="right") - 1, 0, s.size - 2)
+    t = (np.log(hm) - s[j]) / (s[j + 1] - s[j])
+    recovery = tab["recovery"][j] + t * (tab["recovery"][j + 1] - tab["recovery"][j])
+    check_hm = np.concatenate([hm, hm])
+    check_h = np.concatenate([hm, hm * (1.0 - 0.5 * recovery)])  # loading, unloading
+    F, dF = law.force(check_h, check_hm)
+    desc = law.describe()
+    meta = {"format": TABLE_FORMAT,
+            "body1": {"radius": s1.radius, **s1.material.describe()},
+            "body2": {"radius": s2.radius, **s2.material.describe()},
+            "coefficients_source": law.pair.coeffs.source,
+            "units": "consistent units of the inputs (F in those of E·R²)",
+            "nodes": desc["nodes"], "error_bound": desc["error_bound"],
+            "calibrated_range_warnings": desc["calibrated_range_warnings"],
+            "evaluation": " ".join(ContactLaw.tables.__doc__.split())}
+    arrays = {k: np.asarray(v, dtype=float) for k, v in tab.items()}
+    arrays.update(check_h=check_h, check_h_max=check_hm, check_F=F, check_dF_dh=dF,
+                  meta=np.array(json.dumps(meta, allow_nan=True)))
+    with open(path, "wb") as fh:  # the name as given (np.savez would append .npz to a bare name)
+        np.savez(fh, **arrays)
+    return arrays
+
+
+def run_table(args: argparse.Namespace) -> int:
+    """CLI handler of ``model table``."""
+    if not str(args.out).endswith(".npz"):
+        raise SystemExit(f"--out must name a .npz file, got {args.out!r}")
+    s1, s2 = _pair(args)
+    arrays = write_table(s1, s2, args.out, args.h_max, _coefficients(args))
+    meta = json.loads(str(arrays["meta"]))
+    bound = meta["error_bound"].get("F", "n/a")
+    sys.stdout.write(f"wrote {args.out}: {meta['nodes']} nodes, h {float(arrays['h_min']):.6g} … "
+                     f"{float(arrays['h_max']):.6g}, error bound of F {bound}\n")
+    return 0
+
+
+def run_curve(args: argparse.Namespace) -> int:
+    """CLI handler of ``model curve``."""
+    s1, s2 = _pair(args)
+    m1, m2 = s1.material, s2.material
+    coeffs = _coefficients(args)
     data = curve(s1, s2, args.h_max, args.points, coeffs, unload=args.unload)
     cyc = data.pop("cycle", None)
     cols = COLUMNS + (("branch",) if args.unload else ())
@@ -103,11 +174,7 @@ def run_curve(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(subparsers) -> None:
-    """Add the ``model`` stage and its ``curve`` command to the top-level parser."""
-    stage = subparsers.add_parser("model", help="closed-form unified contact model")
-    cmds = stage.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    p = cmds.add_parser("curve", help="force-approach curve F(h), a(h), h1, h2, dF/dh")
+def _body_arguments(p) -> None:
     g1 = p.add_argument_group("body 1")
     g1.add_argument("--E", type=float, required=True, help="Young's modulus (inf: rigid)")
     g1.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (default 0.3)")
@@ -123,11 +190,25 @@ def register(subparsers) -> None:
     g2.add_argument("--K2", type=float)
     g2.add_argument("--n2", type=float)
     g2.add_argument("--radius2", type=float)
+    p.add_argument("--coefficients", help="coefficient JSON file (default data/coefficients.json)")
+
+
+def register(subparsers) -> None:
+    """Add the ``model`` stage and its ``curve`` and ``table`` commands to the top-level parser."""
+    stage = subparsers.add_parser("model", help="closed-form unified contact model")
+    cmds = stage.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    p = cmds.add_parser("curve", help="force-approach curve F(h), a(h), h1, h2, dF/dh")
+    _body_arguments(p)
     p.add_argument("--h-max", type=float, required=True, help="largest approach h")
     p.add_argument("--points", type=int, default=50, help="number of points (default 50)")
-    p.add_argument("--coefficients", help="coefficient JSON file (default data/coefficients.json)")
     p.add_argument("--unload", action="store_true",
                    help="append the unloading branch to the residual approach and the cycle's energies")
     p.add_argument("--json", action="store_true", help="write JSON instead of CSV")
     p.add_argument("--out", help="output file (default: stdout)")
     p.set_defaults(func=run_curve)
+    t = cmds.add_parser("table", help="the pair's fast-path table as plain arrays (.npz) for a DEM code")
+    _body_arguments(t)
+    t.add_argument("--h-max", type=float, default=None,
+                   help="largest approach of the table (default: half the smaller radius)")
+    t.add_argument("--out", required=True, help="output .npz file")
+    t.set_defaults(func=run_table)

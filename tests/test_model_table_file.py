@@ -1,0 +1,59 @@
+"""``spherecontact model table``: the fast path's table as a plain .npz a DEM code evaluates alone."""
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+from test_model_unloading import _force_from_tables
+
+from spherecontact.cli import main
+from spherecontact.model import CalibrationRangeWarning, Material, Sphere
+from spherecontact.model.cli import TABLE_FORMAT, write_table
+from spherecontact.model.fast import ContactLaw
+
+STEEL = ["--E", "210e9", "--sigma-y", "400e6", "--K", "600e6", "--n", "0.3", "--radius", "1e-3"]
+ALU = ["--E2", "70e9", "--nu2", "0.33", "--sigma-y2", "100e6", "--K2", "200e6", "--n2", "0.5",
+       "--radius2", "2e-3"]
+
+
+def _arrays(path):
+    with np.load(path) as d:
+        return {k: d[k] for k in d.files}
+
+
+def test_cli_table_file_evaluates_to_the_fast_path_without_the_package(tmp_path, capsys):
+    out = tmp_path / "steel_alu.npz"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)  # yield ratio 4: extrapolated
+        assert main(["model", "table", *STEEL, *ALU, "--h-max", "2e-4", "--out", str(out)]) == 0
+    assert "nodes" in capsys.readouterr().out
+    tab = _arrays(out)
+    meta = json.loads(str(tab["meta"]))
+    assert meta["format"] == TABLE_FORMAT and meta["body2"]["radius"] == pytest.approx(2e-3)
+    assert "ln_F_hermite" in meta["evaluation"] and meta["calibrated_range_warnings"]
+    assert float(tab["h_max"]) == pytest.approx(2e-4)
+    assert tab["ln_F_hermite"].shape == (tab["ln_h"].size - 1, 4)
+    # the stored reference evaluations, reproduced from the arrays alone (loading and unloading)
+    F, k = _force_from_tables(tab, tab["check_h"], tab["check_h_max"])
+    np.testing.assert_allclose(F, tab["check_F"], rtol=1e-12)
+    np.testing.assert_allclose(k, tab["check_dF_dh"], rtol=1e-9)
+    assert np.any(tab["check_h"] < tab["check_h_max"]) and np.all(tab["check_F"] > 0)
+
+
+def test_write_table_matches_a_fresh_law_and_refuses_bad_input(tmp_path):
+    s1 = Sphere(1.0, Material(E=200.0, nu=0.3, sigma_y=1.0))
+    flat = Sphere(np.inf, Material.rigid())
+    tab = write_table(s1, flat, tmp_path / "flat.npz", h_max=0.2)
+    law = ContactLaw(s1, flat, h_max=0.2)
+    rng = np.random.default_rng(3)
+    hm = np.exp(rng.uniform(np.log(1e-5), np.log(0.2), 500))
+    h = hm * rng.uniform(0.9, 1.0, hm.size)
+    np.testing.assert_allclose(_force_from_tables(_arrays(tmp_path / "flat.npz"), h, hm)[0],
+                               law.force(h, hm)[0], rtol=1e-12)
+    assert set(tab) >= {"ln_h", "recovery", "m", "h_elastic", "meta"}
+    with pytest.raises(ValueError, match="h_max"):
+        write_table(s1, flat, tmp_path / "bad.npz", h_max=-1.0)
+    with pytest.raises(SystemExit, match="--out must name a .npz file"):
+        main(["model", "table", "--E", "200", "--sigma-y", "1", "--radius", "1", "--out",
+              str(tmp_path / "table.txt")])
