@@ -616,6 +616,10 @@ class TwoBodySolver(CycleLegs):
         #: master-curvature part −λ ∂²g of the contact blocks (positive definite when the bodies'
         #: tangent is) instead of its LDLᵀ (:meth:`SymmetricSolver.solve_upper`)
         self.curvature_substitute = True
+        #: penalty contact: the tangent predictor adds the springs of the points it pushes into
+        #: contact (:meth:`_entering_contact`); ``contact_corrections`` counts the increments
+        self.contact_predictor = True
+        self.contact_corrections = 0
 
     # ------------------------------------------------------------------ bodies
     def _body_elastic(self, i: int):
@@ -962,6 +966,7 @@ class TwoBodySolver(CycleLegs):
         self.linear = SymmetricSolver(self.options.linear_solver)
         self._pattern = None  # penalty contact's fixed pattern, made at the first contact
         self.pattern_builds = 0
+        self.contact_corrections = 0
         self._forget_tangent()  # _tangent: penalty contact's K of the last solve
         self.rejected = []
         self.plastic_frozen_increments = 0
@@ -1061,8 +1066,10 @@ class TwoBodySolver(CycleLegs):
     def _tangent_predictor(self, u: np.ndarray, dh: float) -> np.ndarray | None:
         """u + Δu with K Δu = 0 on the free dofs and body 1's equator moved by −dh, K the last
         converged increment's tangent on its stored factors (penalty contact: the plain
-        symmetric system; :meth:`IndentationSolver._tangent_predictor`). None when those
-        factors are not at hand (exact contact's saddle-point systems keep the secant)."""
+        symmetric system; :meth:`IndentationSolver._tangent_predictor`), then, for penalty contact
+        on the fixed pattern, the springs of the points it pushes into contact
+        (:meth:`_entering_contact`, unless ``contact_predictor`` is off). None when those factors
+        are not at hand (exact contact's saddle-point systems keep the secant)."""
         if self._tangent is None:
             return None
         b1 = self.bodies[0]
@@ -1080,7 +1087,50 @@ class TwoBodySolver(CycleLegs):
             return None
         du = du_c
         du[free] = x
-        return u + du
+        u_pred = u + du
+        if self.k_penalty is None or not self.fixed_pattern or not self.contact_predictor:
+            return u_pred
+        return u_pred + self._entering_contact(u, u_pred)
+
+    def _entering_contact(self, u: np.ndarray, u_pred: np.ndarray) -> np.ndarray:
+        """Correction of the tangent predictor ``u_pred`` for the penalty points it pushes into
+        contact (gap ≥ 0 at u, < 0 at u_pred): the stored tangent K has no spring there, so the
+        predicted state leaves each of them penetrating by about the step's closing. With
+        c_i = w k_N A_i and U = [√c_i ∂g_i] (rank r, the points' gradients at u_pred),
+        (K + U Uᵀ) δ = −Σ c_i g_i ∂g_i by Woodbury's identity on K's stored factors: r + 1
+        triangular solves, no factorisation. Where the contact edge passes a surface node the
+        uncorrected first residual was 10–100× the reaction (E-ratio-3 pair of equal hardness,
+        3 Gauss points per edge, P = 3000 approach-scaled; to h/R 0.3: 1046 Newton iterations
+        against 1150, 194 increments against 198, F within 0.01 % on average)."""
+        free = self.free
+        grads, forces = [], []
+        for p in self.passes:
+            before, after = p.kinematics(u), p.kinematics(u_pred)
+            rows = np.flatnonzero((after.gap < 0.0) & (before.gap >= 0.0))
+            if not rows.size:
+                continue
+            dofs, signs = p._dofs_and_signs(after.seg, rows)
+            G = np.zeros((rows.size, self.n_dofs))
+            np.add.at(G, (np.broadcast_to(np.arange(rows.size), dofs.shape), dofs),
+                      p._expand(after.grad[:, rows], rows) * signs)
+            grads.append(G)
+            c = p.weight * self.k_penalty * p.area0[rows]
+            forces.append(np.array([c * after.gap[rows], c]))
+        if not grads:
+            return np.zeros(self.n_dofs)
+        G = np.concatenate(grads)
+        G[:, ~free] = 0.0
+        cg, c = np.concatenate(forces, axis=1)  # c_i g_i and c_i
+        U = G.T * np.sqrt(c)
+        b = -(G.T @ cg)
+        solved = [self.linear.resolve(v) for v in (b, *U.T)]
+        if any(x is None or not np.all(np.isfinite(x)) for x in solved):
+            return np.zeros(self.n_dofs)
+        Kb, KU = solved[0], np.column_stack(solved[1:])
+        delta = Kb - KU @ np.linalg.solve(np.eye(c.size) + U.T @ KU, U.T @ Kb)
+        delta[~free] = 0.0
+        self.contact_corrections += 1
+        return delta
 
     def _commit(self, run: _RunState, h_new: float, solved, branch: int) -> None:
         """Record a converged increment and make it the run's state."""
@@ -1143,7 +1193,8 @@ class TwoBodySolver(CycleLegs):
                    "increments": int(curves["h"].size), "newton_iterations": int(curves["iterations"].sum()),
                    "rejected_increments": len(self.rejected),
                    "plastic_frozen_increments": self.plastic_frozen_increments,
-                   "backed_up_increments": self.backed_up_increments}
+                   "backed_up_increments": self.backed_up_increments,
+                   "contact_corrections": self.contact_corrections}
         b1, b2 = self.bodies
         inputs = {"scene": "two_body", "material": b1.material.describe(), "radius": b1.radius,
                   "material2": b2.material.describe(), "radius2": b2.radius,
