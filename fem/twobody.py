@@ -1127,7 +1127,12 @@ class TwoBodySolver(CycleLegs):
         if any(x is None or not np.all(np.isfinite(x)) for x in solved):
             return np.zeros(self.n_dofs)
         Kb, KU = solved[0], np.column_stack(solved[1:])
-        delta = Kb - KU @ np.linalg.solve(np.eye(c.size) + U.T @ KU, U.T @ Kb)
+        try:  # I + Uᵀ K⁻¹ U is positive definite where K is; an LDLᵀ-factored K may not be
+            delta = Kb - KU @ np.linalg.solve(np.eye(c.size) + U.T @ KU, U.T @ Kb)
+        except np.linalg.LinAlgError:
+            return np.zeros(self.n_dofs)
+        if not np.all(np.isfinite(delta)):
+            return np.zeros(self.n_dofs)
         delta[~free] = 0.0
         self.contact_corrections += 1
         return delta
