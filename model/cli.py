@@ -28,7 +28,8 @@ from .fast import ContactLaw
 from .material import Material
 from .sphere import Sphere
 
-__all__ = ["register", "curve", "run_curve", "write_table", "run_table", "TABLE_FORMAT"]
+__all__ = ["register", "curve", "run_curve", "write_table", "run_table", "TABLE_FORMAT",
+           "TABLE_SUFFIXES"]
 
 #: format name of the ``model table`` file (its ``meta`` says how to evaluate it)
 TABLE_FORMAT = "spherecontact-contact-table/1"
@@ -92,8 +93,14 @@ def _coefficients(args: argparse.Namespace):
     return load_coefficients(args.coefficients) if args.coefficients else default_coefficients()
 
 
+#: file formats of ``model table``, by suffix
+TABLE_SUFFIXES = (".npz", ".txt")
+
+
 def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs=None) -> dict:
-    """Write the pair's fast-path table to ``path`` (``.npz``) and return what was written.
+    """Write the pair's fast-path table to ``path`` and return what was written: a NumPy ``.npz``
+    of the arrays below, or a ``.txt`` of the same numbers for codes without NumPy
+    (:func:`_write_text`).
 
     Arrays: those of :meth:`ContactLaw.tables` (``ln_h``, ``ln_F_hermite``, ``recovery``, ``m``;
     the scalars ``h_elastic``, ``h_min``, ``h_max`` as 0-d arrays), the reference evaluations
@@ -103,6 +110,9 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     error bounds and the evaluation recipe (the docstring of ``ContactLaw.tables``). Units are
     those of the inputs.
     """
+    suffix = str(path)[-4:]
+    if suffix not in TABLE_SUFFIXES:
+        raise ValueError(f"path must end in {' or '.join(TABLE_SUFFIXES)}, got {str(path)!r}")
     law = ContactLaw(s1, s2, h_max=h_max, coeffs=coeffs)
     tab = law.tables()
     hm = np.geomspace(max(law.h_min, 1e-6 * law.h_max), law.h_max, CHECK_POINTS)
@@ -125,15 +135,39 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     arrays = {k: np.asarray(v, dtype=float) for k, v in tab.items()}
     arrays.update(check_h=check_h, check_h_max=check_hm, check_F=F, check_dF_dh=dF,
                   meta=np.array(json.dumps(meta, allow_nan=True)))
+    if suffix == ".txt":
+        _write_text(path, arrays, meta)
+        return arrays
     with open(path, "wb") as fh:  # the name as given (np.savez would append .npz to a bare name)
         np.savez(fh, **arrays)
     return arrays
 
 
+def _write_text(path, arrays: dict, meta: dict) -> None:
+    """The table as text: ``#`` lines with the format, ``meta`` (one JSON line), the scalars
+    ``h_elastic h_min h_max`` and the reference evaluations (``# check h h_max F dF/dh``), then
+    one row per node j: ln_h, c₀ … c₃ of interval j (NaN on the last node), recovery, m. Every
+    number in 17 significant digits (read back exactly)."""
+    n = arrays["ln_h"].size
+    cF = np.vstack([arrays["ln_F_hermite"], np.full((1, 4), np.nan)])
+    rows = np.column_stack([arrays["ln_h"], cF, arrays["recovery"], arrays["m"]])
+    lines = [f"# {TABLE_FORMAT} (text)", f"# meta: {json.dumps(meta, allow_nan=True)}",
+             "# h_elastic h_min h_max: " + " ".join(f"{float(arrays[k]):.17g}"
+                                                   for k in ("h_elastic", "h_min", "h_max")),
+             "# check h h_max F dF/dh: reference evaluations of force(h, h_max)"]
+    lines += [f"# check {h:.17g} {hm:.17g} {F:.17g} {k:.17g}" for h, hm, F, k in
+              zip(arrays["check_h"], arrays["check_h_max"], arrays["check_F"], arrays["check_dF_dh"],
+                  strict=True)]
+    lines.append(f"# columns ({n} nodes): ln_h c0 c1 c2 c3 recovery m")
+    lines += [" ".join(f"{v:.17g}" for v in row) for row in rows]
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write("\n".join(lines) + "\n")
+
+
 def run_table(args: argparse.Namespace) -> int:
     """CLI handler of ``model table``."""
-    if not str(args.out).endswith(".npz"):
-        raise SystemExit(f"--out must name a .npz file, got {args.out!r}")
+    if not str(args.out).endswith(TABLE_SUFFIXES):
+        raise SystemExit(f"--out must name a {' or '.join(TABLE_SUFFIXES)} file, got {args.out!r}")
     s1, s2 = _pair(args)
     arrays = write_table(s1, s2, args.out, args.h_max, _coefficients(args))
     meta = json.loads(str(arrays["meta"]))
@@ -210,5 +244,5 @@ def register(subparsers) -> None:
     _body_arguments(t)
     t.add_argument("--h-max", type=float, default=None,
                    help="largest approach of the table (default: half the smaller radius)")
-    t.add_argument("--out", required=True, help="output .npz file")
+    t.add_argument("--out", required=True, help="output file: .npz (NumPy) or .txt (text)")
     t.set_defaults(func=run_table)

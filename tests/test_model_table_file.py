@@ -9,7 +9,7 @@ from test_model_unloading import _force_from_tables
 
 from spherecontact.cli import main
 from spherecontact.model import CalibrationRangeWarning, Material, Sphere
-from spherecontact.model.cli import TABLE_FORMAT, write_table
+from spherecontact.model.cli import TABLE_FORMAT, TABLE_SUFFIXES, write_table
 from spherecontact.model.fast import ContactLaw
 
 STEEL = ["--E", "210e9", "--sigma-y", "400e6", "--K", "600e6", "--n", "0.3", "--radius", "1e-3"]
@@ -54,6 +54,42 @@ def test_write_table_matches_a_fresh_law_and_refuses_bad_input(tmp_path):
     assert set(tab) >= {"ln_h", "recovery", "m", "h_elastic", "meta"}
     with pytest.raises(ValueError, match="h_max"):
         write_table(s1, flat, tmp_path / "bad.npz", h_max=-1.0)
-    with pytest.raises(SystemExit, match="--out must name a .npz file"):
+    with pytest.raises(ValueError, match="path must end in .npz or .txt"):
+        write_table(s1, flat, tmp_path / "table.csv", h_max=0.2)
+    with pytest.raises(SystemExit, match="--out must name a .npz or .txt file"):
         main(["model", "table", "--E", "200", "--sigma-y", "1", "--radius", "1", "--out",
-              str(tmp_path / "table.txt")])
+              str(tmp_path / "table.csv")])
+
+
+def _read_text(path):
+    """The .txt table read back as a code without NumPy's .npz reader would: '#' lines, then rows."""
+    tab, checks = {}, []
+    for line in open(path, encoding="utf-8"):
+        if line.startswith("# meta: "):
+            tab["meta"] = json.loads(line[len("# meta: "):])
+        elif line.startswith("# h_elastic h_min h_max: "):
+            tab["h_elastic"], tab["h_min"], tab["h_max"] = map(float, line.split(":")[1].split())
+        elif line.startswith("# check ") and ":" not in line:
+            checks.append([float(v) for v in line.split()[2:]])
+    rows = np.loadtxt(path, comments="#")
+    tab.update(ln_h=rows[:, 0], ln_F_hermite=rows[:-1, 1:5], recovery=rows[:, 5], m=rows[:, 6])
+    return tab, np.array(checks)
+
+
+def test_text_table_holds_the_same_numbers_as_the_npz(tmp_path):
+    assert TABLE_SUFFIXES == (".npz", ".txt")
+    s1 = Sphere(1.0, Material(E=500.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3))
+    s2 = Sphere(2.0, Material(E=900.0, nu=0.25, sigma_y=3.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        npz = write_table(s1, s2, tmp_path / "pair.npz", h_max=0.3)
+        write_table(s1, s2, tmp_path / "pair.txt", h_max=0.3)
+    tab, checks = _read_text(tmp_path / "pair.txt")
+    assert tab["meta"]["format"] == TABLE_FORMAT and tab["meta"]["nodes"] == npz["ln_h"].size
+    assert np.isnan(np.loadtxt(tmp_path / "pair.txt", comments="#")[-1, 1:5]).all()
+    for key in ("ln_h", "ln_F_hermite", "recovery", "m", "h_elastic", "h_min", "h_max"):
+        np.testing.assert_array_equal(tab[key], npz[key])  # 17 digits: the same doubles
+    assert checks.shape == (npz["check_h"].size, 4)
+    F, k = _force_from_tables(tab, checks[:, 0], checks[:, 1])
+    np.testing.assert_allclose(F, checks[:, 2], rtol=1e-12)
+    np.testing.assert_allclose(k, checks[:, 3], rtol=1e-9)
