@@ -105,10 +105,10 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     Arrays: those of :meth:`ContactLaw.tables` (``ln_h``, ``ln_F_hermite``, ``recovery``, ``m``;
     the scalars ``h_elastic``, ``h_min``, ``h_max`` as 0-d arrays), the reference evaluations
     ``check_h``, ``check_h_max``, ``check_F``, ``check_dF_dh`` (``CHECK_POINTS`` loading contacts
-    and as many half way down their peaks' elastic recovery, from ``ContactLaw.force``), and ``meta``: a JSON
-    string with the format name, both bodies, the coefficient source, the table's measured
-    error bounds and the evaluation recipe (the docstring of ``ContactLaw.tables``). Units are
-    those of the inputs.
+    and as many half way down their peaks' elastic recovery, from ``ContactLaw.force``), and
+    ``meta``: a standard JSON string (an infinite radius or modulus as the string "inf") with
+    the format name, both bodies, the coefficient source, the table's measured error bounds and
+    the evaluation recipe (the docstring of ``ContactLaw.tables``). Units are those of the inputs.
     """
     suffix = str(path)[-4:]
     if suffix not in TABLE_SUFFIXES:
@@ -132,15 +132,28 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
             "nodes": desc["nodes"], "error_bound": desc["error_bound"],
             "calibrated_range_warnings": desc["calibrated_range_warnings"],
             "evaluation": " ".join(ContactLaw.tables.__doc__.split())}
+    meta = _strict_json(meta)
     arrays = {k: np.asarray(v, dtype=float) for k, v in tab.items()}
     arrays.update(check_h=check_h, check_h_max=check_hm, check_F=F, check_dF_dh=dF,
-                  meta=np.array(json.dumps(meta, allow_nan=True)))
+                  meta=np.array(json.dumps(meta, allow_nan=False)))
     if suffix == ".txt":
         _write_text(path, arrays, meta)
         return arrays
     with open(path, "wb") as fh:  # the name as given (np.savez would append .npz to a bare name)
         np.savez(fh, **arrays)
     return arrays
+
+
+def _strict_json(v):
+    """``v`` with every non-finite float as the string "inf", "-inf" or "nan" (a flat's radius,
+    a rigid body's modulus): standard JSON, which a C or C++ reader parses."""
+    if isinstance(v, dict):
+        return {k: _strict_json(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [_strict_json(x) for x in v]
+    if isinstance(v, float) and not math.isfinite(v):
+        return str(v)
+    return v
 
 
 def _write_text(path, arrays: dict, meta: dict) -> None:
@@ -151,7 +164,7 @@ def _write_text(path, arrays: dict, meta: dict) -> None:
     n = arrays["ln_h"].size
     cF = np.vstack([arrays["ln_F_hermite"], np.full((1, 4), np.nan)])
     rows = np.column_stack([arrays["ln_h"], cF, arrays["recovery"], arrays["m"]])
-    lines = [f"# {TABLE_FORMAT} (text)", f"# meta: {json.dumps(meta, allow_nan=True)}",
+    lines = [f"# {TABLE_FORMAT} (text)", f"# meta: {json.dumps(meta, allow_nan=False)}",
              "# h_elastic h_min h_max: " + " ".join(f"{float(arrays[k]):.17g}"
                                                    for k in ("h_elastic", "h_min", "h_max")),
              "# check h h_max F dF/dh: reference evaluations of force(h, h_max)"]

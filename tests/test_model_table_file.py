@@ -85,6 +85,13 @@ def test_text_table_holds_the_same_numbers_as_the_npz(tmp_path):
         npz = write_table(s1, s2, tmp_path / "pair.npz", h_max=0.3)
         write_table(s1, s2, tmp_path / "pair.txt", h_max=0.3)
     tab, checks = _read_text(tmp_path / "pair.txt")
+    # standard JSON for readers without Infinity/NaN (a flat's radius is the string "inf")
+    flat = write_table(s1, Sphere(np.inf, Material.rigid()), tmp_path / "flat.txt", h_max=0.3)
+
+    def refuse(name):
+        raise ValueError(f"non-standard JSON constant {name}")
+    meta = json.loads(str(flat["meta"]), parse_constant=refuse)
+    assert meta["body2"]["radius"] == "inf" and meta["body2"]["E"] == "inf"
     assert tab["meta"]["format"] == TABLE_FORMAT and tab["meta"]["nodes"] == npz["ln_h"].size
     assert np.isnan(np.loadtxt(tmp_path / "pair.txt", comments="#")[-1, 1:5]).all()
     for key in ("ln_h", "ln_F_hermite", "recovery", "m", "h_elastic", "h_min", "h_max"):
