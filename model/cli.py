@@ -116,10 +116,7 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     law = ContactLaw(s1, s2, h_max=h_max, coeffs=coeffs)
     tab = law.tables()
     hm = np.geomspace(max(law.h_min, 1e-6 * law.h_max), law.h_max, CHECK_POINTS)
-    s = tab["ln_h"]  # each unloading point half way down its peak's elastic recovery δ_e
-    j = np.clip(np.searchsorted(s, np.log(hm), side="right") - 1, 0, s.size - 2)
-    t = (np.log(hm) - s[j]) / (s[j + 1] - s[j])
-    recovery = tab["recovery"][j] + t * (tab["recovery"][j + 1] - tab["recovery"][j])
+    recovery = law._peaks(hm)[3]  # δ_e/h_max: each unloading point half way down its recovery
     check_hm = np.concatenate([hm, hm])
     check_h = np.concatenate([hm, hm * (1.0 - 0.5 * recovery)])  # loading, unloading
     F, dF = law.force(check_h, check_hm)
@@ -137,7 +134,7 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     arrays.update(check_h=check_h, check_h_max=check_hm, check_F=F, check_dF_dh=dF,
                   meta=np.array(json.dumps(meta, allow_nan=False)))
     if suffix == ".txt":
-        _write_text(path, arrays, meta)
+        _write_text(path, arrays)
         return arrays
     with open(path, "wb") as fh:  # the name as given (np.savez would append .npz to a bare name)
         np.savez(fh, **arrays)
@@ -156,7 +153,7 @@ def _strict_json(v):
     return v
 
 
-def _write_text(path, arrays: dict, meta: dict) -> None:
+def _write_text(path, arrays: dict) -> None:
     """The table as text: ``#`` lines with the format, ``meta`` (one JSON line), the scalars
     ``h_elastic h_min h_max`` and the reference evaluations (``# check h h_max F dF/dh``), then
     one row per node j: ln_h, c₀ … c₃ of interval j (NaN on the last node), recovery, m. Every
@@ -164,7 +161,7 @@ def _write_text(path, arrays: dict, meta: dict) -> None:
     n = arrays["ln_h"].size
     cF = np.vstack([arrays["ln_F_hermite"], np.full((1, 4), np.nan)])
     rows = np.column_stack([arrays["ln_h"], cF, arrays["recovery"], arrays["m"]])
-    lines = [f"# {TABLE_FORMAT} (text)", f"# meta: {json.dumps(meta, allow_nan=False)}",
+    lines = [f"# {TABLE_FORMAT} (text)", f"# meta: {arrays['meta']}",
              "# h_elastic h_min h_max: " + " ".join(f"{float(arrays[k]):.17g}"
                                                    for k in ("h_elastic", "h_min", "h_max")),
              "# check h h_max F dF/dh: reference evaluations of force(h, h_max)"]
