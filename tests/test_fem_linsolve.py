@@ -140,6 +140,10 @@ def test_cholesky_reuses_its_analysis_keeps_explicit_zeros_and_gives_way_to_ldl(
     x2 = s.solve_upper(*pattern.upper(3.0 * K.data, fixed, 6.0), b, pattern)
     assert np.allclose(x2, x1 / 3.0, rtol=1e-12)
     assert np.allclose(s.resolve(b), x2, rtol=1e-12)  # the tangent predictor's solve, no refactorisation
+    B = np.column_stack([b, b**2, -b])  # several right-hand sides in one supernodal solve
+    X = s.resolve(B)
+    assert X.shape == B.shape
+    assert np.allclose(X, np.column_stack([s.resolve(c) for c in B.T]), rtol=0, atol=1e-14)
     assert s.stats == {**NONE, "cholesky_fresh": 1, "cholesky_update": 1}
     shifted = K - 0.5 * sp.eye(n, format="csr")  # the Laplacian's lowest eigenvalue is ~0.24
     shifted.sort_indices()
@@ -279,6 +283,8 @@ def test_resolve_reuses_the_factors_of_the_last_accepted_solution(method):
     b = rng.standard_normal(K.shape[0])
     counts = dict(s.stats)
     assert np.allclose(K @ s.resolve(b), b, rtol=0, atol=1e-10)
+    B = rng.standard_normal((K.shape[0], 3))  # several right-hand sides: columns of the result
+    assert np.allclose(K @ s.resolve(B), B, rtol=0, atol=1e-10)
     assert s.stats == counts  # no factorisation
 
 

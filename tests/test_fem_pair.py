@@ -96,6 +96,10 @@ def test_early_stopped_projection_equals_the_fully_iterated_one(monkeypatch):
     assert np.ptp(full[0][2]) > 1.5
     for a, b in zip(fast[0] + (fast[1],), full[0] + (full[1],), strict=True):
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-12 * np.abs(b).max())
+    monkeypatch.undo()
+    # the Hessian's perturbed projections started from the real ones: the same to round-off
+    H = gap_hessian(C, 1.0, t=fast[0][2])
+    np.testing.assert_allclose(H, full[1], rtol=0, atol=1e-12 * np.abs(full[1]).max())
 
 
 @pytest.mark.parametrize("kw, scene", [
@@ -250,3 +254,28 @@ def test_penalty_pairs_converge_to_the_tighter_pair_tolerance():
     finals = [res[-1] for res in r.residuals if res]
     # the first increments stop at the roundoff floor of their tiny reactions (above 1e-8)
     assert len(finals) >= 10 and max(finals[5:]) <= PENALTY_PAIR_TOL < 1e-4
+
+
+def test_pair_tolerance_follows_the_contact_scheme():
+    """Newton's tolerance for two bodies: 1e-8 under the modulus-scaled penalty, 1e-5 under the
+    approach-scaled one at the nodes or with the mortar, the one-body 1e-4 under the Gauss points;
+    a tighter tolerance in the options is kept (the run records the one it used)."""
+    from spherecontact.fem.solver import NEWTON_TOL, SolverOptions
+    from spherecontact.fem.twobody import (
+        APPROACH_PAIR_TOL,
+        PENALTY_PAIR_TOL,
+        POINTS_PAIR_TOL,
+        TwoBodySolver,
+        pair_tolerance,
+    )
+
+    approach = dict(penalty=3000.0, penalty_scale="approach")
+    assert pair_tolerance(SolverOptions(penalty=100.0)) == PENALTY_PAIR_TOL == 1e-8
+    assert pair_tolerance(SolverOptions(**approach)) == APPROACH_PAIR_TOL == 1e-5
+    assert pair_tolerance(SolverOptions(**approach, segment_points=3, segment_scheme="mortar")) == 1e-5
+    assert pair_tolerance(SolverOptions(**approach, segment_points=3)) == POINTS_PAIR_TOL == NEWTON_TOL
+    plastic = Material(E=200.0, nu=0.3, sigma_y=1.0)
+    for tol, used in ((1e-3, POINTS_PAIR_TOL), (1e-6, 1e-6)):
+        s = TwoBodySolver(plastic, 1.0, plastic, 1.0, density=0.5,
+                          options=SolverOptions(**approach, segment_points=3, tol=tol))
+        assert s.options.tol == used
