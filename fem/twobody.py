@@ -323,9 +323,15 @@ class ContactPass:
         d2 = (xs[0][:, None] - xm[0][None]) ** 2 + (xs[1][:, None] - xm[1][None]) ** 2
         k = np.argmin(d2, axis=1)
         last = self.ctrl_nodes.shape[1] - 1
-        # the interval holding t: the one ending at the nearest master node, else the one starting
-        # there (projected only for the points whose t fell outside the first)
-        first, second = self._intervals_at(k)
+        # the interval holding t: of the two at the nearest master node, the one on the side the
+        # point lies along the arc (its offset on the chord through the node's neighbours), else
+        # the other (projected only for the points whose t fell outside the first). Taking the
+        # interval ending at the node first sent half the points to the second projection
+        ends, starts = self._intervals_at(k)
+        n_arc = xm.shape[1]
+        tangent = xm[:, np.minimum(k + 1, n_arc - 1)] - xm[:, np.maximum(k - 1, 0)]
+        ahead = np.sum((xs - xm[:, k]) * tangent, axis=0) > 0.0
+        first, second = np.where(ahead, starts, ends), np.where(ahead, ends, starts)
         best, excess = self._projected(xs, u, np.clip(first, 0, last))
         redo = np.flatnonzero(excess > 0.0)
         if redo.size:
