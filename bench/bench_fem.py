@@ -22,6 +22,8 @@ equal yield stress, E₂ = 3E₁ (E/σY 200 and 600), R₂ = 2R₁, two-pass pen
 to h = 0.03 R₁, against body 1 alone on a rigid flat to the same approach (target: ≤ 3× its wall
 time); ``pair_approach``: the same pair with the penalty scaled with the approach (P = 3000;
 ``fem.pair_speed``, whose ``make verify-pair-speed`` times the campaign's pairs to h/R 0.3).
+The pairs' split per iteration has the same phases (constraints: the penalty tangent's assembly
+on its pattern) and the tangent predictor's (its triangular solves, its contact correction).
 """
 
 from __future__ import annotations
@@ -100,6 +102,9 @@ def pair_run(**options) -> dict:
             "status": res.status, "n_dofs": solver.n_dofs, "wall_s": round(t["wall_s"], 2),
             "increments": t["increments"], "newton_iterations": t["newton_iterations"],
             "rejected_increments": t["rejected_increments"],
+            "ms_per_iteration": round(1e3 * t["wall_s"] / t["newton_iterations"], 1),
+            "ms_per_iteration_split": {k: round(1e3 * t[f"{k}_s"] / t["newton_iterations"], 2)
+                                       for k in (*PHASES, "predictor")},
             "linear": linear_counts(t),
             "F_end": float(res.F[-1]), "h_end": float(res.h[-1]),
             "body1_flat_wall_s": round(flat["wall_s"], 2),

@@ -673,7 +673,10 @@ class TwoBodySolver(CycleLegs):
         self.fixed = np.unique(np.concatenate(fixed))
         self.free = np.ones(self.n_dofs, dtype=bool)
         self.free[self.fixed] = False
-        self.timers = {"constitutive": 0.0, "assembly": 0.0, "solve": 0.0, "contact": 0.0}
+        #: seconds per phase (:meth:`_timed_linear`), as the one-body solver splits them, and the
+        #: tangent predictor's (its triangular solves and contact correction)
+        self.timers = {k: 0.0 for k in ("constitutive", "assembly", "contact", "constraints", "factorisation",
+                                        "solve", "line_search", "predictor")}
         # the block-diagonal CSR pattern of both bodies' tangents (each body's is fixed)
         (p1, i1), (p2, i2) = (b.disc.csr_pattern for b in self.bodies)
         self._K_indptr = np.concatenate([p1, p2[1:] + p1[-1]]).astype(np.int64)
@@ -791,15 +794,30 @@ class TwoBodySolver(CycleLegs):
             system = sp.bmat([[K[free][:, free], -scale * Gf.T],
                               [-scale * Gf, sp.csr_matrix((n_act, n_act))]], format="csc")
             rhs = np.concatenate([-f[free], scale * kin.gap[active]])
-            sol = self.linear.solve_saddle(system, rhs, n_act)  # LDLᵀ + refinement, SuperLU fallback
+            # LDLᵀ + refinement, SuperLU fallback
+            sol = self._timed_linear(t3, self.linear.solve_saddle, system, rhs, n_act)
             du = np.zeros(nd)
             du[free] = sol[:free.sum()]
             lam = np.zeros_like(lam)
             lam[active] = scale * sol[free.sum():]
+            t4 = time.perf_counter()
             u, known, kin = self._line_search(u, du, f, kin, states, self._exact_force(active, lam))
-            self.timers["solve"] += time.perf_counter() - t3
+            self.timers["line_search"] += time.perf_counter() - t4
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {log['res'][-1]:.2e})")
+
+    def _timed_linear(self, t0: float, step, *args):
+        """``step(*args)``, the Newton step's linear phase begun at ``t0``, timed into
+        ``factorisation`` and ``solve`` (the linear solver's own) and ``constraints`` (the rest:
+        the system's or the penalty tangent's assembly, the pattern)."""
+        lin = self.linear.times
+        f0, s0 = lin["factorisation"], lin["solve"]
+        out = step(*args)
+        fact, solve = lin["factorisation"] - f0, lin["solve"] - s0
+        self.timers["factorisation"] += fact
+        self.timers["solve"] += solve
+        self.timers["constraints"] += time.perf_counter() - t0 - fact - solve
+        return out
 
     def _line_search(self, u, du, f0, kin0, states, contact_force, max_steps: int = LINE_SEARCH_STEPS):
         """Energy line search on the Lagrangian with the new multipliers fixed
@@ -987,10 +1005,10 @@ class TwoBodySolver(CycleLegs):
                 return (u, per_body, f, pens[0], lams[0] / p0.weight, kin0.gap, kin0.normal, it, log, F)
             self.timers["contact"] += time.perf_counter() - t2
             K = self._bodies_tangent(per_body, states)
-            t3 = time.perf_counter()
-            du = self._penalty_step(K, r, kins, pens, lams)
+            du = self._timed_linear(time.perf_counter(), self._penalty_step, K, r, kins, pens, lams)
+            t4 = time.perf_counter()
             u, known, kins = self._line_search(u, du, f, kins, states, self._penalty_force)
-            self.timers["solve"] += time.perf_counter() - t3
+            self.timers["line_search"] += time.perf_counter() - t4
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {log['res'][-1]:.2e})")
 
@@ -1161,6 +1179,14 @@ class TwoBodySolver(CycleLegs):
         are not at hand (exact contact's saddle-point systems keep the secant)."""
         if self._tangent is None:
             return None
+        t0 = time.perf_counter()
+        try:
+            return self._tangent_step(u, dh)
+        finally:
+            self.timers["predictor"] += time.perf_counter() - t0
+
+    def _tangent_step(self, u: np.ndarray, dh: float) -> np.ndarray | None:
+        """:meth:`_tangent_predictor`'s u + Δu (its stored tangent at hand)."""
         b1 = self.bodies[0]
         du_c = np.zeros(self.n_dofs)
         du_c[b1.offset + 2 * b1.hmesh.equator + 1] = -dh
