@@ -14,6 +14,9 @@ percentage points). Against an independent reference: the elastic dissimilar pai
 ``make verify-pair`` (E₂/E₁ = 3, R₂ = 2R₁, ν 0.3 / 0.2, 2× mesh) with the same penalty, F against
 the reference contact radius vs Hertz with E*, R* and h₁/h₂ vs E′₂/E′₁ (its limits: 1 % and 2 %).
 
+Each pair's record and its flat run's carry the milliseconds per Newton iteration, whole and by
+phase (:func:`iteration_split`), which is where a pair's cost against the flat's is read.
+
 ``python -m spherecontact.fem.pair_speed --out reports/fem`` → ``approach_pairs.json`` (~4 min);
 ``--segment-points 3``: the same with the penalty at 3 Gauss points per edge (two passes, the
 convention of campaign v2's pairs of equal yield stress) → ``approach_pairs_points3.json``. Their
@@ -79,6 +82,18 @@ def _timed(kw: dict):
     return res, time.perf_counter() - t0
 
 
+#: the phases of a Newton iteration the solvers time (the pair's predictor is its own phase)
+PHASES = ("constitutive", "assembly", "contact", "constraints", "factorisation", "solve", "line_search",
+          "predictor")
+
+
+def iteration_split(timings: dict) -> dict:
+    """Milliseconds per Newton iteration: the whole and each of :data:`PHASES` the run timed."""
+    n = max(timings["newton_iterations"], 1)
+    return {"total": round(1e3 * timings["wall_s"] / n, 2),
+            **{k: round(1e3 * timings[f"{k}_s"] / n, 2) for k in PHASES if f"{k}_s" in timings}}
+
+
 def check_case(case, stored, flat_wall: float, penalty: float = PENALTY, segment_points: int = 0) -> dict:
     res, wall = _timed(pair_kwargs(case, penalty, segment_points))
     R = min(case.inputs["radius"], case.inputs["radius2"])
@@ -87,6 +102,7 @@ def check_case(case, stored, flat_wall: float, penalty: float = PENALTY, segment
             "status": res.status, "reason": res.reason,
             "h_end": float(res.h[-1]), "wall_s": wall, "increments": res.timings["increments"],
             "newton_iterations": res.timings["newton_iterations"], "n_dofs": res.inputs["n_dofs"],
+            "ms_per_iteration": iteration_split(res.timings),
             "wall_s_stored": float(stored.provenance.get("wall_s", np.nan)),
             "wall_over_body1_flat": wall / flat_wall, "target_ratio": TARGET_RATIO,
             "vs_stored": cmp, "split_max": split_difference(stored.curves, res.curves, 0.01 * R)}
@@ -113,15 +129,19 @@ def main(argv: list[str] | None = None) -> int:
     db = Database(args.db)
     cases = {c.name: c for c in load_campaign(args.campaign).cases}
     flats: dict[str, float] = {}  # body 1's flat run, once per distinct body 1 and mesh
+    flat_split: dict[str, dict] = {}
     rows = []
     for name in CASES:
         case = cases[name]
         key = json.dumps({k: str(v) for k, v in flat_kwargs(case).items()}, sort_keys=True)
         if key not in flats:
             flat, flats[key] = _timed(flat_kwargs(case))
+            flat_split[key] = {"newton_iterations": flat.timings["newton_iterations"],
+                               "ms_per_iteration": iteration_split(flat.timings)}
             print(f"body 1 on a flat: {flats[key]:.1f} s ({flat.status})", flush=True)
         row = check_case(case, db.run(case.key), flats[key], args.penalty, args.segment_points)
         row["wall_s_body1_flat"] = flats[key]
+        row["body1_flat"] = flat_split[key]
         rows.append(row)
         F, a = row["vs_stored"]["F"], row["vs_stored"]["a"]
         print(f"{name}: {row['status']} to h/R {row['h_end']:.3f} in {row['wall_s']:.1f} s "

@@ -44,3 +44,12 @@ def test_the_pairs_are_rerun_with_the_approach_scaled_penalty_and_body_1_alone()
         flat = flat_kwargs(case)
         assert "radius2" not in flat and "options" not in flat
         assert flat["material"].sigma_y == kw["material2"].sigma_y  # equal hardness
+
+
+def test_iteration_split_reads_the_phases_a_run_timed():
+    """Milliseconds per Newton iteration of the whole run and of each phase it timed; a phase the
+    run did not time (the one-body solver has no predictor phase) is left out, not reported as 0."""
+    from spherecontact.fem.pair_speed import iteration_split
+
+    t = {"wall_s": 2.0, "newton_iterations": 100, "factorisation_s": 0.5, "line_search_s": 0.25}
+    assert iteration_split(t) == {"total": 20.0, "factorisation": 5.0, "line_search": 2.5}
