@@ -936,13 +936,14 @@ class TwoBodySolver(CycleLegs):
                   for p, kin, pen, lam in zip(self.passes, kins, pens, lams, strict=True)]
         normal = np.concatenate([v.ravel() for _, v, _ in blocks])
         curvature = np.concatenate([v.ravel() for _, _, v in blocks])
-        pos = self._contact_positions([d for d, _, _ in blocks])
+        dofs = [d for d, _, _ in blocks]
+        pos = self._contact_positions(dofs)
         if pos is None:
             pat = self._pattern
             before = [(0.0, 0, 0)] * len(self.passes) if pat is None else pat.windows
             self._fixed_pattern([grown_window(w, p.reach(kin, pen)) for p, w, kin, pen
                                  in zip(self.passes, before, kins, pens, strict=True)])
-            pos = self._contact_positions([d for d, _, _ in blocks])
+            pos = self._contact_positions(dofs)
             if pos is None:  # the zone covers every penetrating pair's couplings by construction
                 raise IncrementFailed("penalty contact coupling outside the grown tangent pattern")
         pat = self._pattern
