@@ -110,7 +110,7 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     the format name, both bodies, the coefficient source, the table's measured error bounds and
     the evaluation recipe (the docstring of ``ContactLaw.tables``). Units are those of the inputs.
     """
-    suffix = str(path)[-4:]
+    suffix = Path(path).suffix
     if suffix not in TABLE_SUFFIXES:
         raise ValueError(f"path must end in {' or '.join(TABLE_SUFFIXES)}, got {str(path)!r}")
     law = ContactLaw(s1, s2, h_max=h_max, coeffs=coeffs)
