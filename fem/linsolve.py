@@ -130,6 +130,7 @@ class SymmetricSolver:
                       "ldl_fresh": 0, "ldl_update": 0, "fallback": 0, "superlu": 0}
         self.times = {"factorisation": 0.0, "solve": 0.0}
         self._reuse = None  # solve() of the factors that gave the last accepted solution
+        self._reuse_columns = False  # ... and whether it takes (n, k) right-hand sides in one call
 
     def resolve(self, b: np.ndarray) -> np.ndarray | None:
         """x with K x = b for the matrix of the last accepted solution, on its stored factors
@@ -139,8 +140,10 @@ class SymmetricSolver:
             return None
         t0 = time.perf_counter()
         b = np.asarray(b, dtype=float)
-        many = isinstance(getattr(self._reuse, "__self__", None), SupernodalCholesky)
-        x = self._reuse(b) if b.ndim == 1 or many else np.column_stack([self._reuse(c) for c in b.T])
+        if b.ndim == 1 or self._reuse_columns:
+            x = self._reuse(b)
+        else:
+            x = np.column_stack([self._reuse(c) for c in b.T])
         self.times["solve"] += time.perf_counter() - t0
         return x
 
@@ -290,6 +293,7 @@ class SymmetricSolver:
                 self.times["solve"] += time.perf_counter() - t1
                 if ok:
                     self._reuse = factors.solve
+                    self._reuse_columns = isinstance(factors, SupernodalCholesky)  # qdldl: one at a time
                     return x
             except (ValueError, RuntimeError):
                 # not reused after a failure
@@ -301,7 +305,7 @@ class SymmetricSolver:
             self.stats["superlu"] += 1
         lu = superlu_factor(full())
         self.times["factorisation"] += time.perf_counter() - t0
-        self._reuse = lu.solve
+        self._reuse, self._reuse_columns = lu.solve, True  # SuperLU solves (n, k) at once
         return lu.solve(b)
 
 

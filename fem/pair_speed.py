@@ -38,7 +38,7 @@ from ..data import Database
 from .design import load_campaign
 from .io import run_indentation
 from .reproduce import compare_loading
-from .solver import SolverOptions
+from .solver import PHASES, SolverOptions
 from .verification_pair import HERTZ_PAIR, hertz_figures
 
 #: the equal-hardness pairs of campaign v1 (penalty contact, default mesh, h/R 0.3)
@@ -82,14 +82,9 @@ def _timed(kw: dict):
     return res, time.perf_counter() - t0
 
 
-#: the phases of a Newton iteration the solvers time (the pair's predictor is its own phase)
-PHASES = ("constitutive", "assembly", "contact", "constraints", "factorisation", "solve", "line_search",
-          "predictor")
-
-
 def phase_split(timings: dict) -> dict:
-    """Milliseconds per Newton iteration of each of :data:`PHASES` the run timed (the one-body
-    solver has no predictor phase)."""
+    """Milliseconds per Newton iteration of each of :data:`~.solver.PHASES` the run timed (timings
+    stored before a phase was split off lack it)."""
     n = max(timings["newton_iterations"], 1)
     return {k: round(1e3 * timings[f"{k}_s"] / n, 2) for k in PHASES if f"{k}_s" in timings}
 

@@ -546,6 +546,13 @@ STEP_SHRINK = 0.7
 STEP_RECOVERY = 1.03
 
 
+#: the phases of a Newton iteration the solvers time (``timers``, ``timings[f"{phase}_s"]``):
+#: the linear phase split into the linear solver's factorisation and triangular solves and the
+#: rest (``constraints``: the system's set-up); ``predictor``: the tangent predictor's solves
+PHASES = ("constitutive", "assembly", "contact", "constraints", "factorisation", "solve", "line_search",
+          "predictor")
+
+
 @dataclass
 class _RunState:
     """The state an incremental run carries from one converged increment to the next."""
@@ -631,10 +638,25 @@ class CycleLegs:
         if run.u_prev is None:
             return first()
         if tangent_ready and self.options.predictor == "tangent":
+            t0 = time.perf_counter()
             u_pred = self._tangent_predictor(run.u, dh)
+            self.timers["predictor"] += time.perf_counter() - t0
             if u_pred is not None:
                 return u_pred
         return run.u + (dh / run.dh_prev) * (run.u - run.u_prev)
+
+    def _timed_linear(self, t0: float, step, *args):
+        """``step(*args)``, the Newton step's linear phase begun at ``t0``, timed into
+        ``factorisation`` and ``solve`` (the linear solver's own) and ``constraints`` (the rest:
+        the system's or the penalty tangent's assembly, the pattern)."""
+        lin = self.linear.times
+        f0, s0 = lin["factorisation"], lin["solve"]
+        out = step(*args)
+        fact, solve = lin["factorisation"] - f0, lin["solve"] - s0
+        self.timers["factorisation"] += fact
+        self.timers["solve"] += solve
+        self.timers["constraints"] += time.perf_counter() - t0 - fact - solve
+        return out
 
     def _out_of_time(self, run: _RunState) -> bool:
         if time.perf_counter() - run.t_start > self.options.max_wall_s:
@@ -865,8 +887,7 @@ class IndentationSolver(CycleLegs):
         self.fixed_base = np.concatenate([2 * hm.equator + 1, 2 * hm.axis])  # u_z equator, u_r axis
         self.n_points = self.disc.n_elements * self.disc.n_qp
         self._elastic = None  # points Newton keeps elastic in the current increment
-        self.timers = {"constitutive": 0.0, "assembly": 0.0, "contact": 0.0, "linear": 0.0,
-                       "line_search": 0.0}
+        self.timers = dict.fromkeys(PHASES, 0.0)  # seconds per phase of the run
         self._diag_slots = self.disc.slots(np.arange(nd), np.arange(nd))
         self._upper = ConstrainedPattern(*self.disc.csr_pattern)
         self._nd = nd
@@ -1045,22 +1066,27 @@ class IndentationSolver(CycleLegs):
             self.timers["constitutive"] += t3 - t2
             self.timers["assembly"] += t4 - t3
             self.timers["contact"] += t5 - t4
-            K = disc.matrix(data)
-            rhs = -r - K @ du_c
-            scale = float(np.abs(data[self._diag_slots]).mean())
-            rhs[fixed] = scale * du_c[fixed]
-            U, diag = self._upper.upper(data, fixed, scale)
-            du = self.linear.solve_upper(U, diag, rhs, self._upper)
-            self._tangent = (K, fixed, scale, frames)
-            du[fixed] = du_c[fixed]
-            du = self._rotate(du, frames)
+            du = self._timed_linear(t5, self._newton_step, data, r, du_c, fixed, frames)
             t6 = time.perf_counter()
-            self.timers["linear"] += t6 - t5
             u, known = self._line_search(u, du, free, frames, state, r[free],
                                          restores_contact(du_c, du))
             self.timers["line_search"] += time.perf_counter() - t6
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {res_hist[-1]:.2e})")
+
+    def _newton_step(self, data, r, du_c, fixed, frames) -> np.ndarray:
+        """Newton's step du with K du = −r on the free dofs (K: the tangent's CSR ``data``) and
+        du = ``du_c`` on the ``fixed`` ones, in global components; K is kept for the tangent
+        predictor."""
+        K = self.disc.matrix(data)
+        rhs = -r - K @ du_c
+        scale = float(np.abs(data[self._diag_slots]).mean())
+        rhs[fixed] = scale * du_c[fixed]
+        U, diag = self._upper.upper(data, fixed, scale)
+        du = self.linear.solve_upper(U, diag, rhs, self._upper)
+        self._tangent = (K, fixed, scale, frames)
+        du[fixed] = du_c[fixed]
+        return self._rotate(du, frames)
 
     def _line_search(self, u, du, free, frames, state, r0, prescribed=False, max_steps: int = 4):
         """u + α du by an energy line search (Crisfield 1991, §9.3).
@@ -1245,15 +1271,6 @@ class IndentationSolver(CycleLegs):
             self._progress(h_new)
         run.last_iterations = its
 
-    def _timer_split(self) -> dict:
-        """Seconds spent per phase: constitutive update, assembly, contact, factorisation,
-        triangular solves, line search (the linear phase's remainder is the constraint setup)."""
-        t = dict(self.timers)
-        lin = self.linear.times
-        t["constraints"] = t.pop("linear") - lin["factorisation"] - lin["solve"]
-        t["factorisation"], t["solve"] = lin["factorisation"], lin["solve"]
-        return {f"{k}_s": v for k, v in t.items()}
-
     # ------------------------------------------------------------------ the incremental run
     def run(self, h_max: float, progress=None, schedule=None, unload_at=None) -> RunResult:
         """Press the hemisphere to approach ``h_max``; ``progress(h)`` is called per increment.
@@ -1313,7 +1330,7 @@ class IndentationSolver(CycleLegs):
         prof_r = np.array(hist.profile_r).reshape(-1, nsurf)
         prof_p = np.array(hist.profile_p).reshape(-1, nsurf)
         prof_g = np.array(hist.profile_g).reshape(-1, nsurf)
-        timings = {"wall_s": wall, "setup_s": self.t_setup, **self._timer_split(),
+        timings = {"wall_s": wall, "setup_s": self.t_setup, **{f"{k}_s": v for k, v in self.timers.items()},
                    "increments": len(hist.h), "newton_iterations": int(curves["iterations"].sum()),
                    "rejected_increments": len(self.rejected),
                    "plastic_frozen_increments": self.plastic_frozen_increments,

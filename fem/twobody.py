@@ -25,6 +25,7 @@ dissipation of each body.
 
 from __future__ import annotations
 
+import functools
 import time
 import warnings
 from dataclasses import dataclass, replace
@@ -44,6 +45,7 @@ from .segment_penalty import edge_gauss_points
 from .segments import CATMULL_ROM, SMOOTH_EDGE, gap_gradient, gap_hessian
 from .solver import (
     LOAD,
+    PHASES,
     ROUNDOFF,
     CycleLegs,
     IncrementFailed,
@@ -436,6 +438,12 @@ class ContactPass:
         last = self.ctrl_nodes.shape[1] - 1
         return r0, np.clip(np.searchsorted(r_arc, r0, side="right") - 1, 0, last)
 
+    @functools.cached_property
+    def _point_groups(self) -> np.ndarray:
+        """Index of each point's set of slave nodes (points of one edge share one): a constant of
+        the pass, used by every :meth:`window_keys`."""
+        return np.unique(self.point_nodes, axis=1, return_inverse=True)[1].ravel()
+
     def window_keys(self, zone: float, lo: int, hi: int) -> np.ndarray:
         """Keys (row · n_dofs + column) of the couplings of every candidate within reference
         radius ``zone`` with the master intervals ``lo`` … ``hi`` away from the one under it in
@@ -447,9 +455,8 @@ class ContactPass:
         seg0, last = seg0[rows], self.ctrl_nodes.shape[1] - 1
         off = np.arange(lo, hi + 1)
         seg = np.clip(seg0[:, None] + off, 0, last).ravel()
-        group = np.unique(self.point_nodes, axis=1, return_inverse=True)[1].ravel()
         rows = np.repeat(rows, off.size)
-        pick = np.unique(group[rows].astype(np.int64) * (last + 1) + seg, return_index=True)[1]
+        pick = np.unique(self._point_groups[rows].astype(np.int64) * (last + 1) + seg, return_index=True)[1]
         dofs = self._pair_dofs(rows[pick], seg[pick])[0]
         return sorted_unique((dofs[:, None, :].astype(np.int64) * self.n_dofs + dofs[None, :, :]).ravel())
 
@@ -673,10 +680,9 @@ class TwoBodySolver(CycleLegs):
         self.fixed = np.unique(np.concatenate(fixed))
         self.free = np.ones(self.n_dofs, dtype=bool)
         self.free[self.fixed] = False
-        #: seconds per phase (:meth:`_timed_linear`), as the one-body solver splits them, and the
-        #: tangent predictor's (its triangular solves and contact correction)
-        self.timers = {k: 0.0 for k in ("constitutive", "assembly", "contact", "constraints", "factorisation",
-                                        "solve", "line_search", "predictor")}
+        #: seconds per phase (:data:`~.solver.PHASES`; the predictor's: its triangular solves and
+        #: contact correction)
+        self.timers = dict.fromkeys(PHASES, 0.0)
         # the block-diagonal CSR pattern of both bodies' tangents (each body's is fixed)
         (p1, i1), (p2, i2) = (b.disc.csr_pattern for b in self.bodies)
         self._K_indptr = np.concatenate([p1, p2[1:] + p1[-1]]).astype(np.int64)
@@ -805,19 +811,6 @@ class TwoBodySolver(CycleLegs):
             self.timers["line_search"] += time.perf_counter() - t4
         raise IncrementFailed(f"no convergence in {opt.max_iterations} iterations "
                               f"(last relative residual {log['res'][-1]:.2e})")
-
-    def _timed_linear(self, t0: float, step, *args):
-        """``step(*args)``, the Newton step's linear phase begun at ``t0``, timed into
-        ``factorisation`` and ``solve`` (the linear solver's own) and ``constraints`` (the rest:
-        the system's or the penalty tangent's assembly, the pattern)."""
-        lin = self.linear.times
-        f0, s0 = lin["factorisation"], lin["solve"]
-        out = step(*args)
-        fact, solve = lin["factorisation"] - f0, lin["solve"] - s0
-        self.timers["factorisation"] += fact
-        self.timers["solve"] += solve
-        self.timers["constraints"] += time.perf_counter() - t0 - fact - solve
-        return out
 
     def _line_search(self, u, du, f0, kin0, states, contact_force, max_steps: int = LINE_SEARCH_STEPS):
         """Energy line search on the Lagrangian with the new multipliers fixed
@@ -1180,14 +1173,6 @@ class TwoBodySolver(CycleLegs):
         are not at hand (exact contact's saddle-point systems keep the secant)."""
         if self._tangent is None:
             return None
-        t0 = time.perf_counter()
-        try:
-            return self._tangent_step(u, dh)
-        finally:
-            self.timers["predictor"] += time.perf_counter() - t0
-
-    def _tangent_step(self, u: np.ndarray, dh: float) -> np.ndarray | None:
-        """:meth:`_tangent_predictor`'s u + Δu (its stored tangent at hand)."""
         b1 = self.bodies[0]
         du_c = np.zeros(self.n_dofs)
         du_c[b1.offset + 2 * b1.hmesh.equator + 1] = -dh

@@ -48,7 +48,7 @@ def test_the_pairs_are_rerun_with_the_approach_scaled_penalty_and_body_1_alone()
 
 def test_iteration_split_reads_the_phases_a_run_timed():
     """Milliseconds per Newton iteration of the whole run and of each phase it timed; a phase the
-    run did not time (the one-body solver has no predictor phase) is left out, not reported as 0."""
+    run did not time (timings stored before the phase was split off) is left out, not reported as 0."""
     from spherecontact.fem.pair_speed import iteration_split
 
     t = {"wall_s": 2.0, "newton_iterations": 100, "factorisation_s": 0.5, "line_search_s": 0.25}

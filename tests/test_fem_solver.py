@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from spherecontact.fem.contact import RigidObstacle
-from spherecontact.fem.solver import IndentationSolver, SolverOptions
+from spherecontact.fem.solver import PHASES, IndentationSolver, SolverOptions
 from spherecontact.model import Material
 from spherecontact.validation.peers import jackson_green, jackson_green_critical
 
@@ -315,6 +315,18 @@ def test_tangent_predictor_is_the_last_converged_tangents_step(indenter, monkeyp
     assert secant.status == fallback.status == "converged"
     assert np.array_equal(fallback.F, secant.F)
     assert abs(secant.F[-1] / res.F[-1] - 1) < 5e-3
+
+
+def test_timings_split_the_newton_phases_and_the_predictor():
+    """Every phase of :data:`PHASES` is timed; the tangent predictor's triangular solves count
+    in its own phase, not in the Newton step's solves or its set-up (``constraints``)."""
+    solver = IndentationSolver(Material(E=E, nu=NU, sigma_y=1.0), 1.0, density=0.5)
+    t = solver.run(0.01).timings
+    assert all(t[f"{k}_s"] >= 0.0 for k in PHASES)
+    assert min(t["factorisation_s"], t["solve_s"], t["predictor_s"], t["constraints_s"]) > 0.0
+    assert sum(t[f"{k}_s"] for k in PHASES) <= t["wall_s"]
+    predictor_solves = solver.linear.times["solve"] - t["solve_s"]
+    assert 0.0 < predictor_solves <= t["predictor_s"]
 
 
 def test_a_failed_loading_step_caps_the_next_ones(monkeypatch):
