@@ -108,13 +108,14 @@ def material2_from_args(args: argparse.Namespace, material: Material) -> Materia
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
     """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
     --strain-increment, --max-wall-s, --no-line-search, --penalty, --segment-points,
-    --segment-scheme, --penalty-scale and --linear-solver."""
+    --segment-scheme, --penalty-scale, --linear-solver and --definite-shift."""
     return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
                          max_iterations=args.max_iterations, tol=args.tol,
                          strain_increment=args.strain_increment, max_wall_s=args.max_wall_s,
                          line_search=not args.no_line_search, penalty=args.penalty,
                          segment_points=args.segment_points, segment_scheme=args.segment_scheme,
-                         penalty_scale=args.penalty_scale, linear_solver=args.linear_solver)
+                         penalty_scale=args.penalty_scale, linear_solver=args.linear_solver,
+                         definite_shift=args.definite_shift)
 
 
 def _check_output(out) -> Path:
@@ -311,6 +312,10 @@ def _add_numerics(add) -> None:
         help="sparse factorisation: 'cholesky' (CHOLMOD's supernodal Cholesky reusing its "
              "analysis, LDL^T where the tangent is not positive definite; default), 'ldl' (qdldl "
              "LDL^T reusing its ordering, SuperLU where it fails) or 'superlu'")
+    add(grp, "--definite-shift", type=float, default=_DEFAULTS.definite_shift,
+        help="one body, --linear-solver cholesky: where Cholesky refuses the tangent, factor it "
+             "with its diagonal raised by this fraction of its magnitude (a damped Newton step; "
+             f"default {_DEFAULTS.definite_shift:g}); 0: LDL^T of the tangent itself")
 
 
 def _add_output(add) -> None:

@@ -56,6 +56,19 @@ REGULARISATION = 1e-10
 REFINEMENTS = 3
 
 
+def shifted_diagonal(U: sp.csc_matrix, diag: np.ndarray, shift: float) -> tuple[sp.csc_matrix, np.ndarray]:
+    """(U', diag') of K + shift · |diag K| on U's pattern (upper triangle, sorted CSC, every
+    diagonal entry stored, so the last of its column): a positive definite substitute for a
+    tangent with a few small negative eigenvalues, whose Newton step is damped along them
+    (modified Newton, Nocedal & Wright 2006, §3.4; Levenberg–Marquardt's scaled diagonal)."""
+    last = U.indptr[1:] - 1
+    if not np.array_equal(U.indices[last], np.arange(U.shape[0])):
+        raise ValueError("U must store every diagonal entry (upper triangle, sorted CSC)")
+    shifted = U.copy()
+    shifted.data[last] += shift * np.abs(U.data[last])
+    return shifted, diag + shift * np.abs(diag)
+
+
 def superlu_factor(K: sp.spmatrix):
     """SuperLU factors of K (MMD on Kᵀ + K, symmetric mode: diagonal pivots preferred)."""
     return spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})

@@ -112,8 +112,9 @@ def measure(E: float, indenter: float, band: float, options: dict, h_max: float 
         by_band[f"{lo:g}-{hi:g}"] = scatter(h[sel], F[sel]) if sel.sum() >= 11 else None
     t = res.timings
     return {"date_utc": datetime.now(UTC).strftime("%Y-%m-%d"), "newton_tol": solver.options.tol,
-            "predictor": solver.options.predictor, "status": res.status, "n_dofs": solver.disc.n_dofs,
-            "wall_s": t["wall_s"],
+            "predictor": solver.options.predictor, "definite_shift": solver.options.definite_shift,
+            "linear": solver.linear.stats, "status": res.status, "n_dofs": solver.disc.n_dofs,
+            "wall_s": t["wall_s"], "rejected_increments": t["rejected_increments"],
             "increments": t["increments"], "newton_iterations": t["newton_iterations"],
             "scatter_F": scatter(h, F, m), "scatter_a": scatter(h, a, m),
             "scatter_F_by_a_band": by_band, "F_end": float(F[-1]), "a_end": float(a[-1])}

@@ -6,7 +6,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from spherecontact.fem.contact import RigidObstacle
-from spherecontact.fem.linsolve import ConstrainedPattern, SupernodalCholesky, SymmetricSolver
+from spherecontact.fem.linsolve import (
+    ConstrainedPattern,
+    SupernodalCholesky,
+    SymmetricSolver,
+    shifted_diagonal,
+)
 from spherecontact.fem.solver import IndentationSolver, SolverOptions
 from spherecontact.model import Material
 
@@ -175,6 +180,49 @@ def test_a_refused_matrix_is_replaced_by_its_definite_substitute_when_one_is_giv
     x = s.solve_upper(U, diag, b, pattern, lambda: pattern.upper(2.0 * shifted.data, fixed, 1.0))
     assert np.abs(_full(U, diag) @ x - b).max() < 1e-9
     assert s.stats["not_definite"] == 2 and s.stats["substitute"] == 1 and s.stats["ldl_fresh"] == 1
+
+
+def test_the_shifted_diagonal_keeps_the_pattern_and_makes_a_slightly_indefinite_matrix_definite():
+    """K + shift·|diag K| on U's own pattern: only the diagonal moves, a matrix with a small
+    negative eigenvalue becomes one Cholesky accepts; a pattern without its diagonal is named."""
+    K = _laplacian(8, shift=0.0)
+    n = K.shape[0]
+    lowest = spla.eigsh(K.tocsc(), k=1, sigma=0.0, return_eigenvectors=False)[0]
+    K = (K - (lowest + 0.02) * sp.eye(n)).tocsr()  # one eigenvalue at -0.02
+    K.sort_indices()
+    pattern = ConstrainedPattern(K.indptr, K.indices)
+    U, diag = pattern.upper(K.data, np.array([], dtype=int), 1.0)
+    with pytest.raises(ArithmeticError):
+        SupernodalCholesky(U).factor(U)
+    U2, diag2 = shifted_diagonal(U, diag, 0.1)
+    assert np.array_equal(U2.indices, U.indices) and np.array_equal(U2.indptr, U.indptr)
+    assert np.allclose(diag2, 1.1 * np.abs(diag))
+    assert np.abs(U2 - U).sum() == pytest.approx(0.1 * np.abs(diag).sum())  # the diagonal alone
+    chol = SupernodalCholesky(U2)
+    chol.factor(U2)
+    b = np.linspace(-1.0, 1.0, n)
+    assert np.abs(_full(U2, diag2) @ chol.solve(b) - b).max() < 1e-10
+    with pytest.raises(ValueError, match="diagonal"):
+        shifted_diagonal(sp.triu(U, k=1, format="csc"), diag, 0.1)
+
+
+def test_a_refused_one_body_tangent_is_shifted_not_left_to_ldl():
+    """E/σY 10⁴ on a flat, fully plastic: Cholesky refuses some tangents. With ``definite_shift``
+    each is factored shifted (no LDLᵀ at all); with 0 they go to LDLᵀ. Over the same increments
+    both converge to the same curve: the shift changes Newton's path, not its answer."""
+    mat = Material(E=1e4, nu=0.3, sigma_y=1.0)
+    exact = IndentationSolver(mat, 1.0, density=0.5, options=SolverOptions(definite_shift=0.0))
+    a = exact.run(0.02)
+    shifted = IndentationSolver(mat, 1.0, density=0.5, options=SolverOptions(definite_shift=0.1))
+    b = shifted.run(0.02, schedule=a.h[a.h > 0])
+    assert a.status == b.status == "converged"
+    assert exact.linear.stats["not_definite"] > 0 and exact.linear.stats["ldl_update"] > 0
+    stats = shifted.linear.stats
+    assert stats["substitute"] == stats["not_definite"] > 0
+    assert stats["ldl_fresh"] == stats["ldl_update"] == stats["fallback"] == 0
+    assert np.array_equal(a.h, b.h) and np.abs(b.F / a.F - 1)[a.F > 0].max() < 1e-3
+    with pytest.raises(ValueError, match=r"definite_shift must be a number in \[0, 10\]"):
+        SolverOptions(definite_shift=-0.1).validate()
 
 
 def test_bad_method_is_named():
