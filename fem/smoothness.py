@@ -89,6 +89,12 @@ CASES = [
     # contact, not only the surface band, in smaller elements
     ("flat E10000, mesh density 1.5, band 0.02, approach penalty 150, Newton 1e-8, secant", 10000.0,
      math.inf, 0.02, {**APPROACH, "penalty": 150.0, "tol": 1e-8, "predictor": "secant", "density": 1.5}),
+    # the same with the tangents Cholesky refuses factored shifted (``definite_shift``) instead of
+    # by LDLᵀ: no increment fails, so none cuts the later steps down
+    ("flat E10000, mesh density 1.5, band 0.02, approach penalty 150, Newton 1e-8, secant, refused "
+     "tangents shifted 0.1", 10000.0, math.inf, 0.02,
+     {**APPROACH, "penalty": 150.0, "tol": 1e-8, "predictor": "secant", "density": 1.5,
+      "definite_shift": 0.1}),
 ]
 BANDS = ((0.01, 0.03), (0.03, 0.1), (0.1, 0.3), (0.3, 1.2))
 
@@ -125,6 +131,8 @@ def _method(r: dict) -> str:
     band = f"band {r['edge_band']:g}" if r["edge_band"] else "default mesh"
     if r.get("density", 1.0) != 1.0:
         band = f"mesh {r['density']:g}×, {band}"
+    if r.get("definite_shift"):
+        band = f"{band}, refused tangents shifted"
     if r.get("penalty_scale") == "approach":
         return f"{band}, penalty over edges ∝ p_m/h"
     if r.get("penalty"):
