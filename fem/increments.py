@@ -13,6 +13,9 @@ first ones, ``io.reference_mask``; log–log interpolation of the new curve), pe
 ``increments_validation.json``: every converged one-body run of the set (``--set``, default
 validation; ``--cases`` picks some), with the re-run curves, which the validation report reads
 (``validation/increments_report.py``); ~8 min for the 30 validation runs on two workers.
+``--h-end 0.3 --relative-step 0 --strain-increment 0.0025 --name …`` checks the whole loading
+window instead: the strain bound halved, no bound by the approach (each decade's mean of
+ln(stored/new) beside its largest, which a surface node closing at another increment sets).
 """
 
 from __future__ import annotations
@@ -54,14 +57,18 @@ def read_reruns(path) -> tuple[dict, dict]:
     return {c["key"]: c for c in d.pop("cases")}, d
 
 
-def rerun(inputs: dict, relative_step: float):
-    """The first loading of a stored one-body case, increments dh ≤ ``relative_step`` · h."""
+def rerun(inputs: dict, relative_step: float | None, h_end: float = H_END,
+          strain_increment: float | None = None):
+    """The first loading of a stored one-body case to ``h_end`` (units of the smaller radius),
+    increments dh ≤ ``relative_step`` · h (None: no such bound) and dh ≤ ``strain_increment`` · a
+    (None: the solver's)."""
+    strain = {} if strain_increment is None else {"strain_increment": strain_increment}
     return run_indentation(material_from_description(inputs["material"]), float(inputs["radius"]),
-                           H_END * smaller_radius(inputs),
+                           h_end * smaller_radius(inputs),
                            indenter_radius=float(inputs.get("indenter_radius", math.inf)),
                            edge_band=float(inputs.get("edge_band", 0.0)),
                            band_floor=inputs.get("band_floor"),
-                           options=SolverOptions(relative_step=relative_step))
+                           options=SolverOptions(relative_step=relative_step, **strain))
 
 
 def by_decade(h_old, y_old, h_new, y_new, length: float) -> dict:
@@ -71,22 +78,25 @@ def by_decade(h_old, y_old, h_new, y_new, length: float) -> dict:
     k = np.floor(np.log10(h_old / length) + 1e-12).astype(int)
     out = {f"1e{d}": float(dev[k == d][np.argmax(np.abs(dev[k == d]))]) for d in np.unique(k)}
     out["largest"] = float(dev[np.argmax(np.abs(dev))])
+    out["mean"] = {f"1e{d}": float(dev[k == d].mean()) for d in np.unique(k)}
     return out
 
 
-def measure(db: Database, case: str, relative_step: float) -> dict:
+def measure(db: Database, case: str, relative_step: float | None, h_end: float = H_END,
+            strain_increment: float | None = None) -> dict:
     rec = next(r for r in db.records() if r.case == case)
     run = db.run(rec.key)
     old = {"h": np.asarray(run.h), "F": np.asarray(run.F), "a": np.asarray(run.a)}
     keep = np.asarray(run.reference)  # loading increments without a first step's transient
     L = smaller_radius(rec.inputs)
     t = time.perf_counter()
-    new = rerun(rec.inputs, relative_step)
+    new = rerun(rec.inputs, relative_step, h_end, strain_increment)
     wall = time.perf_counter() - t
     keep &= (old["h"] >= new.h[0]) & (old["h"] <= new.h[-1])
     ka = keep & (old["a"] >= A_RESOLVED * L)
-    return {"case": case, "key": rec.key, "relative_step": relative_step, "wall_s": round(wall, 1),
-            "stored_increments": int(np.count_nonzero(old["h"][loading_mask(run.curves)] <= H_END * L)),
+    return {"case": case, "key": rec.key, "relative_step": relative_step,
+            "strain_increment": strain_increment, "wall_s": round(wall, 1),
+            "stored_increments": int(np.count_nonzero(old["h"][loading_mask(run.curves)] <= h_end * L)),
             "new_increments": int(new.h.size),
             "F": by_decade(old["h"][keep], old["F"][keep], new.h, new.F, L),
             "a": by_decade(old["h"][ka], old["a"][ka], new.h, new.a, L) if ka.any() else None,
@@ -94,8 +104,8 @@ def measure(db: Database, case: str, relative_step: float) -> dict:
 
 
 def _measure_in_worker(args: tuple) -> dict:
-    db_path, case, relative_step = args
-    return measure(Database(db_path), case, relative_step)
+    db_path, case, *steps = args
+    return measure(Database(db_path), case, *steps)
 
 
 def one_body_cases(db: Database, set_name: str) -> list[str]:
@@ -110,20 +120,33 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default="reports/fem")
     ap.add_argument("--set", default="validation", help="every converged one-body case of this set")
     ap.add_argument("--cases", nargs="*", default=None, help="these cases instead of --set")
-    ap.add_argument("--relative-step", type=float, default=RELATIVE_STEP)
+    ap.add_argument("--relative-step", type=float, default=RELATIVE_STEP,
+                    help=f"increments dh <= this * h (default {RELATIVE_STEP:g}; 0: no such bound)")
+    ap.add_argument("--h-end", type=float, default=H_END,
+                    help=f"approach the re-runs end at, in units of the smaller radius (default {H_END:g})")
+    ap.add_argument("--strain-increment", type=float, default=None,
+                    help="increments dh <= this * a (default: the solver's)")
     ap.add_argument("--workers", type=int, default=2, help="processes (one case each at a time)")
     ap.add_argument("--name", default="increments_validation.json", help="file written in --out")
     args = ap.parse_args(argv)
+    if not 0.0 <= args.relative_step <= 10.0:
+        ap.error(f"--relative-step must lie in [0, 10] (0: no bound), got {args.relative_step:g}")
+    if not 0.0 < args.h_end <= 0.5:
+        ap.error(f"--h-end must lie in (0, 0.5] (units of the smaller radius), got {args.h_end:g}")
+    relative_step = args.relative_step or None
     db = Database(args.db)
     cases = args.cases if args.cases else one_body_cases(db, args.set)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    results = {"date_utc": datetime.now(UTC).strftime("%Y-%m-%d"), "db": args.db, "h_end": H_END,
-               "note": "ln(stored/new) per decade of h over the smaller radius, largest |.|, at the "
-                       "stored loading increments after the first ones (a: where a >= 0.01 of the "
-                       "smaller radius); new: increments dh <= relative_step h", "cases": []}
+    results = {"date_utc": datetime.now(UTC).strftime("%Y-%m-%d"), "db": args.db, "h_end": args.h_end,
+               "note": "ln(stored/new) per decade of h over the smaller radius, largest |.| (and the "
+                       "decade's mean under 'mean'), at the stored loading increments after the first "
+                       "ones (a: where a >= 0.01 of the smaller radius); new: increments dh <= "
+                       "relative_step h (null: no such bound) and dh <= strain_increment a (null: "
+                       "the solver's)", "cases": []}
+    work = [(args.db, c, relative_step, args.h_end, args.strain_increment) for c in cases]
     with ProcessPoolExecutor(max(1, args.workers), mp_context=multiprocessing.get_context("fork")) as pool:
-        done = pool.map(_measure_in_worker, [(args.db, c, args.relative_step) for c in cases])
+        done = pool.map(_measure_in_worker, work)
         for case, r in zip(cases, done, strict=True):
             results["cases"].append(r)
             _print(case, r)

@@ -246,9 +246,12 @@ def test_increment_check_reports_the_largest_deviation_per_decade():
     h_old = np.array([2e-6, 5e-6, 2e-5, 5e-5, 3e-4, 2e-3])
     off = np.array([-0.01, -0.03, -0.02, 0.01, 0.004, -0.001])
     d = by_decade(h_old, h_old**1.3 * np.exp(off), h_new, F_new, 1.0)
-    assert set(d) == {"1e-6", "1e-5", "1e-4", "1e-3", "largest"}
+    assert set(d) == {"1e-6", "1e-5", "1e-4", "1e-3", "largest", "mean"}
     assert d["1e-6"] == pytest.approx(-0.03, abs=1e-9) and d["1e-5"] == pytest.approx(-0.02, abs=1e-9)
     assert d["1e-4"] == pytest.approx(0.004, abs=1e-9) and d["largest"] == pytest.approx(-0.03, abs=1e-9)
+    # each decade's mean beside its largest: a systematic shift, not one closing node
+    assert d["mean"]["1e-6"] == pytest.approx(-0.02, abs=1e-9)
+    assert d["mean"]["1e-5"] == pytest.approx(-0.005, abs=1e-9)
 
 
 def _pressed_pair(segment_points: int, h: float = 2e-3):
