@@ -254,6 +254,16 @@ def test_increment_check_reports_the_largest_deviation_per_decade():
     assert d["mean"]["1e-5"] == pytest.approx(-0.005, abs=1e-9)
 
 
+@pytest.mark.parametrize(("flag", "value"), [("--h-end", "0.9"), ("--relative-step", "-1")])
+def test_increment_check_names_a_bad_window_or_step(flag, value, capsys):
+    """The re-run's end and step bound are checked before any database is read or run made."""
+    from spherecontact.fem.increments import main
+
+    with pytest.raises(SystemExit):
+        main(["--db", "missing.h5", "--cases", "none", flag, value])
+    assert f"{flag} must lie in" in capsys.readouterr().err
+
+
 def _pressed_pair(segment_points: int, h: float = 2e-3):
     """A pair E₂ = 3E₁, R₂ = 2R₁ with penalty contact and u: body 1 moved down by h, rigidly; the
     two-pass Gauss points are the reference contact of such pairs: no SegmentPairWarning."""
