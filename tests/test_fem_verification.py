@@ -37,3 +37,16 @@ def test_run_builds_the_band_mesh_it_is_given():
     band = _run("elastic", 200.0, 2e-4, edge_band=CAMPAIGN_BAND, options=dict(dh_first=1e-4, dh_max=1e-4))
     assert band["n_dofs"] > plain["n_dofs"]
     assert band["status"] == plain["status"] == "converged"
+
+
+def test_a_run_on_another_runs_approaches_steps_to_them():
+    """The mesh check without the increments' share: the refined run is stepped to the default
+    run's converged approaches (``loading_approaches``), so both curves share their h."""
+    from spherecontact.fem.verification import loading_approaches
+
+    opts = dict(dh_first=1e-4, dh_max=2e-4)
+    coarse = _run("epp", 200.0, 1e-3, density=0.5, options=opts)
+    fine = _run("epp", 200.0, 1e-3, density=0.75, options=opts, schedule=loading_approaches(coarse))
+    assert coarse["status"] == fine["status"] == "converged"
+    assert np.array_equal(loading_approaches(fine), loading_approaches(coarse))
+    assert fine["n_dofs"] > coarse["n_dofs"]
