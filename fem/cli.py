@@ -297,7 +297,7 @@ def _add_numerics(add) -> None:
     add(grp, "--segment-points", type=int, default=0,
         help="with --penalty: integrate the contact pressure at this many Gauss points per surface "
              "edge, 1-64 (default 0: at the nodes); two bodies: see --segment-scheme, and the split "
-             "of spheres of equal yield stress is nearly neutral with smooth surfaces (README)")
+             "of spheres of equal yield stress is nearly neutral with smooth surfaces (fem/README.md)")
     add(grp, "--segment-scheme", choices=SEGMENT_SCHEMES, default=_DEFAULTS.segment_scheme,
         help="two bodies with --segment-points: 'points' (default; each Gauss point its own "
              "penalty, both bodies in turn) or 'mortar' (one pass of the softer body's weighted "
@@ -306,7 +306,7 @@ def _add_numerics(add) -> None:
         help="with --penalty: 'modulus' (default), stiffness penalty * E / (pole element "
              "length); 'approach', stiffness penalty * p_m / h, so the obstacle (or the other "
              "body) presses in by about h / penalty at every approach (one body: use with "
-             "--segment-points; README, 'Smoothness of F'). The curve h is then the bodies' own "
+             "--segment-points; fem/README.md, 'Smoothness of F'). The curve h is then the bodies' own "
              "shortening and h_applied the travel of the equator(s)")
     add(grp, "--linear-solver", choices=LINEAR_METHODS, default=_DEFAULTS.linear_solver,
         help="sparse factorisation: 'cholesky' (CHOLMOD's supernodal Cholesky reusing its "

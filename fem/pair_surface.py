@@ -9,7 +9,7 @@ contact radius, in the final state of the run. The rms second difference is repo
 
 In two-pass nodal penalty contact both surfaces take the same sawtooth, corner nodes pressed into
 each body and midside nodes standing out; surfaces of that shape that slide past each other ride
-over each other's bumps, which frictionless contact should not have to do (README, "Smoothness of
+over each other's bumps, which frictionless contact should not have to do (fem/README.md, "Smoothness of
 F"; data/README.md, "Surface band of the pairs").
 
 The bodies' meshes are rebuilt from the run's inputs (gmsh is deterministic) to find the surface

@@ -16,7 +16,7 @@ pressed by a rigid flat or sphere (EPP, ν = 0.3):
 
 ``--only i j …`` runs those cases and keeps the other cases' earlier figures. Each record
 carries the date, the Newton tolerance and the predictor it was measured with: at E/σY 10⁴ the
-scatter moves with them (README, "Smoothness of F").
+scatter moves with them (fem/README.md, "Smoothness of F").
 
 Writes ``smoothness.json`` and ``smoothness.png`` (scatter of F against wall time).
 ``python -m spherecontact.fem.smoothness --out reports/fem`` (~85 min on one core).

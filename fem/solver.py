@@ -123,7 +123,7 @@ class SolverOptions:
     #: Newton step damped along the negative directions; 0 (default): LDLᵀ of K, the exact
     #: Newton step. E/σY 10⁴ on a flat (mesh 1.5×, to h/R 0.03), 0.1: no rejected increment
     #: instead of 13, so half the increments; not the default because the increments the
-    #: failures no longer cost change the verified runs (README, "Linear solves")
+    #: failures no longer cost change the verified runs (fem/README.md, "Linear solves")
     definite_shift: float = 0.0
     #: "tangent": the last converged increment's factorised tangent applied to the new approach
     #: step (:meth:`IndentationSolver._tangent_predictor`), the secant where it is not at hand;

@@ -266,7 +266,7 @@ def test_smoothness_rerun_of_some_cases_keeps_the_others(tmp_path, monkeypatch):
 
 
 def test_smoothness_records_the_solver_settings_each_figure_was_measured_with():
-    """A scatter figure depends on the Newton tolerance and the predictor (README: E/σY 10⁴ on
+    """A scatter figure depends on the Newton tolerance and the predictor (fem/README.md: E/σY 10⁴ on
     the band 0.02, 1.61 % at 1e-4 with the tangent predictor, 0.53 % at 1e-8 with the secant
     one), so every measurement carries them and its date."""
     import re

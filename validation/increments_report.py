@@ -3,7 +3,7 @@
 ``make verify-increments`` (``fem/increments.py``) re-runs the first loading of the one-body
 validation runs, up to h/R = 0.01, with increments dh ≤ 0.03 h as well as the strain bound, and
 stores those curves (``reports/fem/increments_validation.json``). The stored campaign curves
-lie below them by up to several per cent where the contact is small (README, "Increments where
+lie below them by up to several per cent where the contact is small (fem/README.md, "Increments where
 the contact is small"); this section reads the model's error over the acceptance window up to
 h/R = 0.01 against both, so that an error there is not mistaken for the model's alone. The
 thresholds are read against the stored curves as before; this section decides nothing.
