@@ -32,8 +32,7 @@ import math
 
 from spherecontact.fem.contact import RigidObstacle
 from spherecontact.fem.pair_speed import PENALTY as PAIR_SPEED_PENALTY
-from spherecontact.fem.pair_speed import phase_split
-from spherecontact.fem.solver import IndentationSolver, SolverOptions
+from spherecontact.fem.solver import IndentationSolver, SolverOptions, phase_split
 from spherecontact.fem.twobody import TwoBodySolver
 from spherecontact.model import Material
 from spherecontact.validation.metrics import scatter

@@ -1,6 +1,6 @@
 """Two bodies at the cost of one: the equal-hardness pairs with the approach-scaled penalty.
 
-Two plastic spheres of equal yield stress need penalty contact (README, "Contact"). With the
+Two plastic spheres of equal yield stress need penalty contact (fem/README.md, "Contact"). With the
 stiffness set by the modulus (k_N = P E*/ℓ, P = 100) the campaign's pairs took 20–35 min to
 h/R 0.3; with k_N = P p_m/h (``penalty_scale`` "approach", bounded so that the bodies sink into
 each other by at most ``twobody.APPROACH_DEPTH`` of a surface node spacing) the contact is
@@ -15,12 +15,15 @@ percentage points). Against an independent reference: the elastic dissimilar pai
 the reference contact radius vs Hertz with E*, R* and h₁/h₂ vs E′₂/E′₁ (its limits: 1 % and 2 %).
 
 Each pair's record and its flat run's carry the milliseconds per Newton iteration, whole and by
-phase (:func:`iteration_split`), which is where a pair's cost against the flat's is read.
+phase (:func:`~.solver.iteration_split`), which is where a pair's cost against the flat's is read.
 
 ``python -m spherecontact.fem.pair_speed --out reports/fem`` → ``approach_pairs.json`` (~4 min);
 ``--segment-points 3``: the same with the penalty at 3 Gauss points per edge (two passes, the
 convention of campaign v2's pairs of equal yield stress) → ``approach_pairs_points3.json``. Their
-smooth split differs from the stored nodal runs' by design (README, "Contact").
+smooth split differs from the stored nodal runs' by design (fem/README.md, "Contact").
+``--edge-band 0.03``: the pairs and the flat run on the campaigns' surface-band mesh instead of the
+stored default mesh (file name ``…_band0.03.json``); ``--interleave N``: each pair and its flat run
+then alternately N times (:func:`interleaved`), the ratio a drifting machine reads fairly.
 """
 
 from __future__ import annotations
@@ -37,8 +40,9 @@ import numpy as np
 from ..data import Database
 from .design import load_campaign
 from .io import run_indentation
+from .mesh import EDGE_BAND_MAX
 from .reproduce import compare_loading
-from .solver import PHASES, SolverOptions
+from .solver import SolverOptions, iteration_split
 from .verification_pair import HERTZ_PAIR, hertz_figures
 
 #: the equal-hardness pairs of campaign v1 (penalty contact, default mesh, h/R 0.3)
@@ -57,10 +61,17 @@ def split_difference(stored: dict, new: dict, h_min: float) -> float:
     return float(np.max(np.abs(mine - np.asarray(stored["h1"])[on] / h[on])))
 
 
-def pair_kwargs(case, penalty: float = PENALTY, segment_points: int = 0) -> dict:
+def _meshed(kw: dict, mesh: dict | None) -> dict:
+    """``kw`` with the surface band of ``mesh`` ({"edge_band": …, "band_floor": …}; None: the
+    stored run's mesh)."""
+    return kw if mesh is None else {**kw, **mesh}
+
+
+def pair_kwargs(case, penalty: float = PENALTY, segment_points: int = 0, mesh: dict | None = None) -> dict:
     """The stored pair's run with the approach-scaled penalty (at the nodes, or at
-    ``segment_points`` Gauss points per edge), without cycles or a wall limit."""
-    kw = case.run_kwargs()
+    ``segment_points`` Gauss points per edge), without cycles or a wall limit, on the stored
+    mesh or on ``mesh`` (:func:`_meshed`)."""
+    kw = _meshed(case.run_kwargs(), mesh)
     kw["unload_at"] = None
     kw["options"] = replace(kw["options"], penalty=penalty, penalty_scale="approach",
                             linear_solver="cholesky", max_wall_s=math.inf,
@@ -68,9 +79,9 @@ def pair_kwargs(case, penalty: float = PENALTY, segment_points: int = 0) -> dict
     return kw
 
 
-def flat_kwargs(case) -> dict:
+def flat_kwargs(case, mesh: dict | None = None) -> dict:
     """Body 1 of the pair alone on a rigid flat, same mesh, the solver's default options."""
-    kw = case.run_kwargs()
+    kw = _meshed(case.run_kwargs(), mesh)
     return {"material": kw["material"], "radius": kw["radius"], "h_max": kw["h_max"],
             "density": kw["density"], "element": kw["element"], "edge_band": kw["edge_band"],
             "band_floor": kw["band_floor"]}
@@ -82,24 +93,13 @@ def _timed(kw: dict):
     return res, time.perf_counter() - t0
 
 
-def phase_split(timings: dict) -> dict:
-    """Milliseconds per Newton iteration of each of :data:`~.solver.PHASES` the run timed (timings
-    stored before a phase was split off lack it)."""
-    n = max(timings["newton_iterations"], 1)
-    return {k: round(1e3 * timings[f"{k}_s"] / n, 2) for k in PHASES if f"{k}_s" in timings}
-
-
-def iteration_split(timings: dict) -> dict:
-    """Milliseconds per Newton iteration: the whole and :func:`phase_split`."""
-    n = max(timings["newton_iterations"], 1)
-    return {"total": round(1e3 * timings["wall_s"] / n, 2), **phase_split(timings)}
-
-
-def check_case(case, stored, flat_wall: float, penalty: float = PENALTY, segment_points: int = 0) -> dict:
-    res, wall = _timed(pair_kwargs(case, penalty, segment_points))
+def check_case(case, stored, flat_wall: float, penalty: float = PENALTY, segment_points: int = 0,
+               mesh: dict | None = None) -> dict:
+    res, wall = _timed(pair_kwargs(case, penalty, segment_points, mesh))
     R = min(case.inputs["radius"], case.inputs["radius2"])
     cmp = compare_loading(stored.curves, res.curves, 0.01 * R)
     return {"case": case.name, "penalty": penalty, "segment_points": segment_points,
+            "edge_band": res.inputs.get("edge_band"), "band_floor": res.inputs.get("band_floor"),
             "status": res.status, "reason": res.reason,
             "h_end": float(res.h[-1]), "wall_s": wall, "increments": res.timings["increments"],
             "newton_iterations": res.timings["newton_iterations"], "n_dofs": res.inputs["n_dofs"],
@@ -107,6 +107,19 @@ def check_case(case, stored, flat_wall: float, penalty: float = PENALTY, segment
             "wall_s_stored": float(stored.provenance.get("wall_s", np.nan)),
             "wall_over_body1_flat": wall / flat_wall, "target_ratio": TARGET_RATIO,
             "vs_stored": cmp, "split_max": split_difference(stored.curves, res.curves, 0.01 * R)}
+
+
+def interleaved(case, rounds: int, penalty: float = PENALTY, segment_points: int = 0,
+                mesh: dict | None = None) -> dict:
+    """The pair and body 1's flat run alternately, ``rounds`` times: the machine's speed drifts
+    by 10–25 % within minutes, and a ratio of two runs made minutes apart carries that drift.
+    Returns each round's walls and ratio, and the ratio of the sums."""
+    rows = []
+    for _ in range(rounds):
+        flat = _timed(flat_kwargs(case, mesh))[1]
+        pair = _timed(pair_kwargs(case, penalty, segment_points, mesh))[1]
+        rows.append({"flat_s": round(flat, 2), "pair_s": round(pair, 2), "ratio": round(pair / flat, 3)})
+    return {"rounds": rows, "ratio": sum(r["pair_s"] for r in rows) / sum(r["flat_s"] for r in rows)}
 
 
 def hertz_check(penalty: float = PENALTY, segment_points: int = 0) -> dict:
@@ -126,7 +139,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--penalty", type=float, default=PENALTY)
     ap.add_argument("--segment-points", type=int, default=0, choices=range(0, 9), metavar="N",
                     help="Gauss points per surface edge for the penalty (0: at the nodes; 1-8)")
+    ap.add_argument("--edge-band", type=float, default=None, metavar="B",
+                    help="surface band for the pairs and their flat runs (default: the stored runs' mesh)")
+    ap.add_argument("--band-floor", type=float, default=0.003, metavar="L",
+                    help="smallest surface element of the band, over R (with --edge-band)")
+    ap.add_argument("--interleave", type=int, default=0, metavar="N",
+                    help="then run each pair and its flat run alternately N times (0-10)")
     args = ap.parse_args(argv)
+    if not 0 <= args.interleave <= 10:
+        ap.error(f"--interleave must be in [0, 10], got {args.interleave}")
+    if args.edge_band is not None and not 0.0 < args.edge_band <= EDGE_BAND_MAX:
+        ap.error(f"--edge-band must be in (0, {EDGE_BAND_MAX:g}], got {args.edge_band}")
+    if not 0.0 < args.band_floor < 0.1:
+        ap.error(f"--band-floor must be in (0, 0.1), got {args.band_floor}")
+    mesh = None if args.edge_band is None else {"edge_band": args.edge_band, "band_floor": args.band_floor}
     db = Database(args.db)
     cases = {c.name: c for c in load_campaign(args.campaign).cases}
     flats: dict[str, float] = {}  # body 1's flat run, once per distinct body 1 and mesh
@@ -134,13 +160,13 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for name in CASES:
         case = cases[name]
-        key = json.dumps({k: str(v) for k, v in flat_kwargs(case).items()}, sort_keys=True)
+        key = json.dumps({k: str(v) for k, v in flat_kwargs(case, mesh).items()}, sort_keys=True)
         if key not in flats:
-            flat, flats[key] = _timed(flat_kwargs(case))
+            flat, flats[key] = _timed(flat_kwargs(case, mesh))
             flat_split[key] = {"newton_iterations": flat.timings["newton_iterations"],
                                "ms_per_iteration": iteration_split(flat.timings)}
             print(f"body 1 on a flat: {flats[key]:.1f} s ({flat.status})", flush=True)
-        row = check_case(case, db.run(case.key), flats[key], args.penalty, args.segment_points)
+        row = check_case(case, db.run(case.key), flats[key], args.penalty, args.segment_points, mesh)
         row["wall_s_body1_flat"] = flats[key]
         row["body1_flat"] = flat_split[key]
         rows.append(row)
@@ -150,6 +176,11 @@ def main(argv: list[str] | None = None) -> int:
               f"F {100 * F['systematic']:+.2f} % (max {100 * F['max']:.2f}, scatter stored "
               f"{100 * F['stored_scatter']:.2f} / new {100 * F['new_scatter']:.2f}), a "
               f"{100 * a['systematic']:+.2f} %, split {100 * row['split_max']:.2f} points", flush=True)
+        if args.interleave:
+            row["interleaved"] = interleaved(case, args.interleave, args.penalty, args.segment_points, mesh)
+            each = ", ".join(f"{r['ratio']:.2f}" for r in row["interleaved"]["rounds"])
+            print(f"  interleaved {args.interleave}x: {row['interleaved']['ratio']:.2f}x body 1's flat "
+                  f"({each})", flush=True)
     hz = hertz_check(args.penalty, args.segment_points)
     print(f"elastic pair vs Hertz (E*, R*): F against a within {hz['F_vs_a_max_pct']:.2f} % (mean "
           f"{hz['F_vs_a_mean_pct']:+.2f} %), h1/h2 within {hz['h1_over_h2_dev_pct_small_h']:.2f} % at "
@@ -157,7 +188,9 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     points = args.segment_points
-    name = f"approach_pairs_points{points}.json" if points else "approach_pairs.json"
+    name = f"approach_pairs_points{points}" if points else "approach_pairs"
+    name += "" if mesh is None else f"_band{args.edge_band:g}"
+    name += ".json"
     (out / name).write_text(json.dumps({"pairs": rows, "hertz": hz}, indent=1) + "\n")
     return 0
 

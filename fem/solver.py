@@ -563,6 +563,19 @@ PHASES = ("constitutive", "assembly", "contact", "constraints", "factorisation",
           "predictor")
 
 
+def phase_split(timings: dict) -> dict:
+    """Milliseconds per Newton iteration of each of :data:`PHASES` a run timed (``RunResult.timings``;
+    timings stored before a phase was split off lack it)."""
+    n = max(timings["newton_iterations"], 1)
+    return {k: round(1e3 * timings[f"{k}_s"] / n, 2) for k in PHASES if f"{k}_s" in timings}
+
+
+def iteration_split(timings: dict) -> dict:
+    """Milliseconds per Newton iteration: the whole run's and :func:`phase_split`."""
+    n = max(timings["newton_iterations"], 1)
+    return {"total": round(1e3 * timings["wall_s"] / n, 2), **phase_split(timings)}
+
+
 @dataclass
 class _RunState:
     """The state an incremental run carries from one converged increment to the next."""

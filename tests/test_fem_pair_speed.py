@@ -49,7 +49,42 @@ def test_the_pairs_are_rerun_with_the_approach_scaled_penalty_and_body_1_alone()
 def test_iteration_split_reads_the_phases_a_run_timed():
     """Milliseconds per Newton iteration of the whole run and of each phase it timed; a phase the
     run did not time (timings stored before the phase was split off) is left out, not reported as 0."""
-    from spherecontact.fem.pair_speed import iteration_split
+    from spherecontact.fem.solver import iteration_split
 
     t = {"wall_s": 2.0, "newton_iterations": 100, "factorisation_s": 0.5, "line_search_s": 0.25}
     assert iteration_split(t) == {"total": 20.0, "factorisation": 5.0, "line_search": 2.5}
+
+
+def test_a_surface_band_given_applies_to_the_pair_and_its_flat_run_alike():
+    cases = {c.name: c for c in load_campaign("data/campaign.toml").cases}
+    case = cases[CASES[2]]
+    assert case.run_kwargs()["edge_band"] == 0.0  # campaign v1's pairs: the default mesh
+    mesh = {"edge_band": 0.03, "band_floor": 0.003}
+    pair, flat = pair_kwargs(case, mesh=mesh), flat_kwargs(case, mesh)
+    for kw in (pair, flat):
+        assert (kw["edge_band"], kw["band_floor"]) == (0.03, 0.003)
+    assert pair_kwargs(case)["edge_band"] == 0.0 and flat_kwargs(case)["edge_band"] == 0.0
+
+
+@pytest.mark.parametrize("args, word", [(["--edge-band", "0.5"], "--edge-band"),
+                                        (["--edge-band", "0.03", "--band-floor", "0"], "--band-floor"),
+                                        (["--interleave", "11"], "--interleave")])
+def test_a_bad_band_is_named_before_any_run(args, word, capsys):
+    from spherecontact.fem.pair_speed import main
+
+    with pytest.raises(SystemExit):
+        main(args)
+    assert word in capsys.readouterr().err
+
+
+def test_interleaved_rounds_alternate_the_flat_and_the_pair(monkeypatch):
+    """Each round runs body 1's flat and then the pair; the ratio is that of the summed walls."""
+    from spherecontact.fem import pair_speed
+
+    calls, walls = [], iter([10.0, 30.0, 12.0, 30.0])
+    monkeypatch.setattr(pair_speed, "_timed", lambda kw: (calls.append("options" in kw), next(walls)))
+    case = {c.name: c for c in load_campaign("data/campaign.toml").cases}[CASES[0]]
+    out = pair_speed.interleaved(case, 2)
+    assert calls == [False, True, False, True]  # flat (no solver options), pair, flat, pair
+    assert [r["ratio"] for r in out["rounds"]] == [3.0, 2.5]
+    assert out["ratio"] == pytest.approx(60.0 / 22.0)
