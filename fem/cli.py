@@ -20,6 +20,7 @@ import numpy as np
 
 from ..model.material import Material
 from .assembly import ELEMENTS
+from .contact import EDGE_FITS
 from .io import SCENES, check_inputs, run_indentation, write_run
 from .linsolve import METHODS as LINEAR_METHODS
 from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN
@@ -108,14 +109,14 @@ def material2_from_args(args: argparse.Namespace, material: Material) -> Materia
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
     """Solver options from --dh-first/--dh-max/--dh-min/--max-iterations/--tol,
     --strain-increment, --max-wall-s, --no-line-search, --penalty, --segment-points,
-    --segment-scheme, --penalty-scale, --linear-solver and --definite-shift."""
+    --segment-scheme, --penalty-scale, --linear-solver, --definite-shift and --edge-fit."""
     return SolverOptions(dh_first=args.dh_first, dh_max=args.dh_max, dh_min=args.dh_min,
                          max_iterations=args.max_iterations, tol=args.tol,
                          strain_increment=args.strain_increment, max_wall_s=args.max_wall_s,
                          line_search=not args.no_line_search, penalty=args.penalty,
                          segment_points=args.segment_points, segment_scheme=args.segment_scheme,
                          penalty_scale=args.penalty_scale, linear_solver=args.linear_solver,
-                         definite_shift=args.definite_shift)
+                         definite_shift=args.definite_shift, edge_fit=args.edge_fit)
 
 
 def _check_output(out) -> Path:
@@ -316,6 +317,10 @@ def _add_numerics(add) -> None:
         help="one body, --linear-solver cholesky: where Cholesky refuses the tangent, factor it "
              "with its diagonal raised by this fraction of its magnitude (a damped Newton step; "
              "0.1 halves the increments of E/sigma_Y 1e4 runs); 0 (default): LDL^T of the tangent")
+    add(grp, "--edge-fit", choices=tuple(EDGE_FITS), default=_DEFAULTS.edge_fit,
+        help="contact radius between nodes: 'hertz' (default, the stored databases' estimate: the gap "
+             "opening as (r - a)^1.5) or 'fitted' (its exponent fitted in [1, 2]: mesh-consistent at "
+             "a plastic edge, 0.4-0.6 %% higher there on the surface-band mesh)")
 
 
 def _add_output(add) -> None:

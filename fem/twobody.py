@@ -1256,11 +1256,12 @@ class TwoBodySolver(CycleLegs):
         xs = s.positions(u, self.candidates)
         areas = surface_areas(s.positions(u, s.hmesh.surface))[:-1]
         pressure = np.where(act, lam_new / areas, 0.0)
-        a_nodes, a_sub, a_ref = contact_edge(s.hmesh.X[0, self.candidates], xs[0], gap, act)
+        a_nodes, a_sub, a_ref = contact_edge(s.hmesh.X[0, self.candidates], xs[0], gap, act,
+                                              self.options.edge_fit)
         if isinstance(self.passes[0], SegmentContactPass):  # the edge fit on the Gauss points' gaps
             p0 = self.passes[0]
             g = self._point_gap
-            a_sub, a_ref = contact_edge(p0.r0, p0._slave_points(u)[0], g, g < 0.0)[1:]
+            a_sub, a_ref = contact_edge(p0.r0, p0._slave_points(u)[0], g, g < 0.0, self.options.edge_fit)[1:]
         self._add_work(run, h_new, F, branch)
         run.h, run.F, run.a = h_new, F, a_ref
         run.h_top = max(run.h_top, h_new)

@@ -92,6 +92,13 @@ def saved_runs(outdir, names, prefix: str) -> dict:
 #: the refined standard run stepped to the standard run's own approaches (mesh check without the
 #: increments' share: the contact radius is a fit over neighbouring increments and moves with them)
 SAME_STEPS = "standard_fine_same_steps"
+#: the same pair of runs with the contact radius's edge exponent fitted (``edge_fit`` "fitted")
+EDGE_FITTED = "standard_edge_fitted"
+SAME_STEPS_FITTED = "standard_fine_same_steps_edge_fitted"
+#: runs made after the pool, each stepped to the approaches of another: name → (case, its
+#: options, the run whose approaches it takes)
+AFTER_POOL = {SAME_STEPS: ("standard_fine", {}, "standard"),
+              SAME_STEPS_FITTED: ("standard_fine", {"edge_fit": "fitted"}, EDGE_FITTED)}
 
 
 def loading_approaches(run: dict) -> np.ndarray:
@@ -130,6 +137,7 @@ def plan(quick: bool) -> dict:
                        options=dict(dh_first=1e-6, dh_max=2e-5)),
         "standard": dict(kind="epp", E_over_sy=200.0, h_max=h_std),
         "standard_fine": dict(kind="epp", E_over_sy=200.0, h_max=h_std, density=d2),
+        EDGE_FITTED: dict(kind="epp", E_over_sy=200.0, h_max=h_std, options=dict(edge_fit="fitted")),
         "standard_dt2": dict(kind="epp", E_over_sy=200.0, h_max=h_std,
                              options=dict(strain_increment=0.0025)),
         "lock_q8r": dict(kind="epp", E_over_sy=1e4, h_max=0.0012,
@@ -231,13 +239,22 @@ def evaluate(runs: dict, quick: bool) -> dict:
                              / local_fit_at(std["curves"]["h"], std["curves"][q], h) - 1 for q in ("F", "a")}
     fit["pass"] = all(abs(v) <= 0.005 for d in fit.values() for v in d.values())
     out["mesh_fit"] = fit
-    same = runs.get(SAME_STEPS)
-    if same is not None:  # the 2× mesh on the default run's increments: the mesh's share alone
-        out["mesh_same_steps"] = {
-            f"h/R={h:g}": {q + "_rel_diff": _at(same, q, h) / _at(std, q, h) - 1 for q in ("F", "a")}
+    for key, fine_key, base in (("mesh_same_steps", SAME_STEPS, std),
+                                ("mesh_same_steps_edge_fitted", SAME_STEPS_FITTED, runs.get(EDGE_FITTED))):
+        same = runs.get(fine_key)
+        if same is None or base is None:
+            continue
+        # the 2× mesh on the default run's increments: the mesh's share alone
+        out[key] = {
+            f"h/R={h:g}": {q + "_rel_diff": _at(same, q, h) / _at(base, q, h) - 1 for q in ("F", "a")}
             | {q + "_fit_rel_diff": local_fit_at(same["curves"]["h"], same["curves"][q], h)
-               / local_fit_at(std["curves"]["h"], std["curves"][q], h) - 1 for q in ("F", "a")}
+               / local_fit_at(base["curves"]["h"], base["curves"][q], h) - 1 for q in ("F", "a")}
             for h in ((0.05, 0.1) if quick else (0.05, 0.1, 0.3))}
+    if EDGE_FITTED in runs:  # the fitted edge against the Hertz exponent's on the same states
+        fitted = runs[EDGE_FITTED]
+        out["edge_fitted_vs_hertz"] = {f"h/R={h:g}": local_fit_at(fitted["curves"]["h"], fitted["curves"]["a"], h)
+                                       / local_fit_at(std["curves"]["h"], std["curves"]["a"], h) - 1
+                                       for h in ((0.05, 0.1) if quick else (0.05, 0.1, 0.3))}
     out["increments"] = {f"h/R={h:g}": {"F_rel_diff": _at(dt2, "F", h) / _at(std, "F", h) - 1,
                                          "a_rel_diff": _at(dt2, "a", h) / _at(std, "a", h) - 1}
                          for h in hs}
@@ -391,10 +408,16 @@ def _report(figures: dict, pngs: list[str], outdir: Path, wall: float, quick: bo
             lines.append(f"| mesh 2× at {key}, on the local quadratic over 11 increments | F, a ≤ 0.5 % | "
                          f"F {100 * v['F_rel_diff']:+.2f} %, a {100 * v['a_rel_diff']:+.2f} % | "
                          f"{abs(v['F_rel_diff']) <= 0.005 and abs(v['a_rel_diff']) <= 0.005} |")
-    for key, v in figures.get("mesh_same_steps", {}).items():
-        lines.append(f"| mesh 2× on the default run's increments at {key}: pointwise; on the local "
-                     f"quadratic | — | F {100 * v['F_rel_diff']:+.2f} %, a {100 * v['a_rel_diff']:+.2f} %; "
-                     f"F {100 * v['F_fit_rel_diff']:+.2f} %, a {100 * v['a_fit_rel_diff']:+.2f} % | — |")
+    for fig, what in (("mesh_same_steps", ""),
+                      ("mesh_same_steps_edge_fitted", ", contact radius with the edge exponent fitted")):
+        for key, v in figures.get(fig, {}).items():
+            lines.append(f"| mesh 2× on the default run's increments at {key}{what}: pointwise; on the "
+                         f"local quadratic | — | F {100 * v['F_rel_diff']:+.2f} %, a {100 * v['a_rel_diff']:+.2f} %; "
+                         f"F {100 * v['F_fit_rel_diff']:+.2f} %, a {100 * v['a_fit_rel_diff']:+.2f} % | — |")
+    if "edge_fitted_vs_hertz" in figures:
+        lines.append("| contact radius with the edge exponent fitted against the Hertz exponent's, standard "
+                     "run, local quadratic | — | " + ", ".join(
+                         f"{k} {100 * v:+.2f} %" for k, v in figures["edge_fitted_vs_hertz"].items()) + " | — |")
     for key, v in figures["increments"].items():
         lines.append(f"| half strain increment at {key} | — | F {100 * v['F_rel_diff']:+.2f} %, "
                      f"a {100 * v['a_rel_diff']:+.2f} % | — |")
@@ -459,12 +482,15 @@ def main(argv: list[str] | None = None) -> int:
                 failed[futures[fut]] = f"{type(err).__name__}: {err}"
     if failed:
         raise SystemExit(f"verification runs failed: {failed}")
-    runs |= saved_runs(outdir, [SAME_STEPS], "run_") if args.reuse else {}
-    made = len(todo) + (SAME_STEPS not in runs)
-    if SAME_STEPS not in runs:  # after the pool: it steps to the standard run's approaches
-        print(f"FE verification: {SAME_STEPS} (the 2x mesh on the standard run's increments)", flush=True)
-        runs[SAME_STEPS] = _run(**cases["standard_fine"], name=SAME_STEPS, log_dir=str(outdir),
-                                schedule=loading_approaches(runs["standard"]))
+    runs |= saved_runs(outdir, list(AFTER_POOL), "run_") if args.reuse else {}
+    made = len(todo) + sum(name not in runs for name in AFTER_POOL)
+    for name, (case, options, steps_of) in AFTER_POOL.items():
+        if name in runs:
+            continue
+        # after the pool: it steps to another run's approaches
+        print(f"FE verification: {name} (the 2x mesh on {steps_of}'s increments)", flush=True)
+        kw = cases[case] | {"options": (cases[case].get("options") or {}) | options}
+        runs[name] = _run(**kw, name=name, log_dir=str(outdir), schedule=loading_approaches(runs[steps_of]))
     figures = evaluate(runs, args.quick)
     pngs = _plots(runs, figures, outdir)
     wall = time.perf_counter() - t0

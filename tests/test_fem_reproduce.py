@@ -1,6 +1,7 @@
 """reproduce: stored and new curves compared on their loading increments."""
 
 import numpy as np
+import pytest
 
 from spherecontact.fem.reproduce import compare_loading
 
@@ -26,3 +27,11 @@ def test_cycles_are_left_out_of_the_comparison():
     off = _curves(h)
     off["F"] = 1.1 * off["F"]
     assert abs(compare_loading(stored, off, 0.01)["F"]["systematic"] - np.log(1.1)) < 1e-12
+
+
+def test_an_unknown_edge_fit_is_named_before_any_run(capsys):
+    from spherecontact.fem.reproduce import main
+
+    with pytest.raises(SystemExit):
+        main(["--edge-fit", "free", "--cases"])
+    assert "--edge-fit" in capsys.readouterr().err

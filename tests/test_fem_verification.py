@@ -50,3 +50,15 @@ def test_a_run_on_another_runs_approaches_steps_to_them():
     assert coarse["status"] == fine["status"] == "converged"
     assert np.array_equal(loading_approaches(fine), loading_approaches(coarse))
     assert fine["n_dofs"] > coarse["n_dofs"]
+
+
+def test_the_edge_fit_is_checked_on_the_standard_run_and_its_2x_mesh_alike():
+    """The mesh check of the fitted contact edge compares like with like: the standard run with
+    ``edge_fit`` "fitted", and the 2× mesh stepped to that run's approaches with the same option."""
+    from spherecontact.fem.verification import AFTER_POOL, EDGE_FITTED, SAME_STEPS, SAME_STEPS_FITTED
+
+    cases = plan(quick=False)
+    assert cases[EDGE_FITTED] == cases["standard"] | {"options": {"edge_fit": "fitted"}}
+    assert AFTER_POOL[SAME_STEPS] == ("standard_fine", {}, "standard")
+    case, options, steps_of = AFTER_POOL[SAME_STEPS_FITTED]
+    assert cases[case]["density"] == 2.0 and options == {"edge_fit": "fitted"} and steps_of == EDGE_FITTED
