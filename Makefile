@@ -7,7 +7,7 @@ export OMP_NUM_THREADS ?= 1
 export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
-.PHONY: test bench lint verify-fem verify-pair verify-pair-speed verify-pair-surface verify-pair-contacts verify-cycles verify-smoothness verify-band verify-increments demo clean
+.PHONY: test bench lint verify-fem verify-pair verify-pair-speed verify-pair-speed-band verify-pair-surface verify-pair-contacts verify-cycles verify-smoothness verify-band verify-increments demo clean
 .PHONY: fem fem-v1 campaign-design
 .PHONY: validate
 .PHONY: calibrate
@@ -62,6 +62,11 @@ verify-pair: $(STAMP)
 # the equal-hardness pairs with the approach-scaled penalty against their stored runs and body 1's flat
 verify-pair-speed: $(STAMP)
 	$(PY) -m spherecontact.fem.pair_speed --out reports/fem
+
+# the same pairs as the campaigns run them (surface band 0.03, Gauss-point penalty), each pair and its
+# flat run also alternately twice: the scatter and wall-time targets for two bodies (~15 min, one core)
+verify-pair-speed-band: $(STAMP)
+	$(PY) -m spherecontact.fem.pair_speed --segment-points 3 --edge-band 0.03 --interleave 2 --out reports/fem
 
 # corner/midside sawtooth of the contact surfaces of every stored two-body run
 verify-pair-surface: $(STAMP)
