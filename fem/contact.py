@@ -110,7 +110,7 @@ def contact_edge(r_ref: np.ndarray, r_cur: np.ndarray, gap: np.ndarray, active: 
 
     With p held at 3/2 ("hertz", the default and the stored databases' estimate) a plastic
     edge's fit spans a length that halves with the mesh and pulls a back towards the last
-    closed node: the standard run's a at h/R 0.05 lay 0.84 % below the 2× mesh's on the same
+    closed node: the standard run's a at h/R 0.05 lay 0.85 % below the 2× mesh's on the same
     approaches. With p fitted (1.1 there, 1.5 on an elastic sphere) 0.19 %, and a reads 0.4–0.6 %
     higher than the "hertz" fit on the campaigns' surface-band mesh (fem/README.md, "Contact
     radius").

@@ -128,7 +128,7 @@ class SolverOptions:
     #: the contact radius's sub-element fit (:func:`~.contact.contact_edge`): "hertz", the gap
     #: opening as (r − a)^{3/2} (the stored databases' a); "fitted", its exponent fitted in [1, 2]
     #: (1.1 at a plastic edge): the standard run's a at h/R 0.05 within 0.19 % of the 2× mesh's on
-    #: the same approaches instead of 0.84 %, and 0.4–0.6 % higher on the surface-band mesh
+    #: the same approaches instead of 0.85 %, and 0.4–0.6 % higher on the surface-band mesh
     edge_fit: str = "hertz"
     #: "tangent": the last converged increment's factorised tangent applied to the new approach
     #: step (:meth:`IndentationSolver._tangent_predictor`), the secant where it is not at hand;
