@@ -40,7 +40,7 @@ import numpy as np
 from ..data import Database
 from .design import load_campaign
 from .io import run_indentation
-from .mesh import EDGE_BAND_MAX
+from .mesh import EDGE_BAND_MAX, check_band_floor
 from .reproduce import compare_loading
 from .solver import SolverOptions, iteration_split
 from .verification_pair import HERTZ_PAIR, hertz_figures
@@ -142,16 +142,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--edge-band", type=float, default=None, metavar="B",
                     help="surface band for the pairs and their flat runs (default: the stored runs' mesh)")
     ap.add_argument("--band-floor", type=float, default=0.003, metavar="L",
-                    help="smallest surface element of the band, over R (with --edge-band)")
+                    help="smallest surface element of the band, over R (with --edge-band; "
+                         "the mesh's BAND_FLOOR_RANGE)")
     ap.add_argument("--interleave", type=int, default=0, metavar="N",
                     help="then run each pair and its flat run alternately N times (0-10)")
     args = ap.parse_args(argv)
     if not 0 <= args.interleave <= 10:
         ap.error(f"--interleave must be in [0, 10], got {args.interleave}")
-    if args.edge_band is not None and not 0.0 < args.edge_band <= EDGE_BAND_MAX:
-        ap.error(f"--edge-band must be in (0, {EDGE_BAND_MAX:g}], got {args.edge_band}")
-    if not 0.0 < args.band_floor < 0.1:
-        ap.error(f"--band-floor must be in (0, 0.1), got {args.band_floor}")
+    if args.edge_band is not None:
+        if not 0.0 < args.edge_band <= EDGE_BAND_MAX:
+            ap.error(f"--edge-band must be in (0, {EDGE_BAND_MAX:g}], got {args.edge_band}")
+        try:  # the mesh's own check, before any run
+            check_band_floor(args.band_floor, args.edge_band)
+        except ValueError as err:
+            ap.error(f"--band-floor: {err}")
     mesh = None if args.edge_band is None else {"edge_band": args.edge_band, "band_floor": args.band_floor}
     db = Database(args.db)
     cases = {c.name: c for c in load_campaign(args.campaign).cases}
