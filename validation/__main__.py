@@ -100,6 +100,9 @@ def main(argv: list[str] | None = None) -> int:
     dt = time.perf_counter() - t0
     print(f"validation: {len(res.comparisons)} runs, report {res.path} ({len(res.pngs)} charts), "
           f"{dt:.1f} s")
+    if res.goal_misses:
+        print(f"validation: the design goal ([goal]) is missed on {len(res.goal_misses)} of "
+              f"{len(res.comparisons)} runs (reported, not the exit status; section \"The design goal\")")
     if res.failures:
         print(f"validation: {len(res.failures)} runs exceed the thresholds:", file=sys.stderr)
         for f in res.failures:

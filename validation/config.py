@@ -16,6 +16,12 @@ Keys (all optional; defaults below)::
     [unloading]                 # acceptance of the unloading law given the FE's peak
     F_branch_max = 0.03         # largest |ΔF|/F_max along each unloading branch
     h_res_max = 0.03            # |Δh_res|/h_max
+
+    [goal]                      # the model's design goal in the acceptance window: reported
+    F_max = 0.03                # per run (section "The design goal"), never the exit status
+    a_max = 0.03
+    rms_max = 0.015             # RMS of the F and of the a error
+    split_max = 0.05            # two bodies: |h₁/h − FE's h₁/h|
 """
 
 from __future__ import annotations
@@ -38,10 +44,15 @@ class Thresholds:
     a_max: float = 0.05
     F_branch_max: float = 0.03
     h_res_max: float = 0.03
+    goal_F_max: float = 0.03
+    goal_a_max: float = 0.03
+    goal_rms_max: float = 0.015
+    goal_split_max: float = 0.05
 
     def __post_init__(self) -> None:
         for name in ("h_over_R_max", "h_over_R_large_max", "large_deformation_from", "a_min_over_R",
-                     "F_max", "a_max", "F_branch_max", "h_res_max"):
+                     "F_max", "a_max", "F_branch_max", "h_res_max", "goal_F_max", "goal_a_max",
+                     "goal_rms_max", "goal_split_max"):
             v = getattr(self, name)
             if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
                 raise ValueError(f"threshold {name} must be a finite number > 0, got {v!r}")
@@ -50,7 +61,10 @@ class Thresholds:
 
 
 _KEYS = {"window": ("h_over_R_max", "h_over_R_large_max", "large_deformation_from", "a_min_over_R"),
-         "model": ("F_max", "a_max"), "unloading": ("F_branch_max", "h_res_max")}
+         "model": ("F_max", "a_max"), "unloading": ("F_branch_max", "h_res_max"),
+         "goal": ("F_max", "a_max", "rms_max", "split_max")}
+#: sections whose keys are stored under a prefix (``[goal] F_max`` → ``goal_F_max``)
+_PREFIX = {"goal": "goal_"}
 
 
 def load_thresholds(path=None) -> Thresholds:
@@ -72,7 +86,7 @@ def load_thresholds(path=None) -> Thresholds:
             if key not in _KEYS[section]:
                 raise ValueError(f"{path}: unknown key {section}.{key} "
                                  f"(known: {', '.join(_KEYS[section])})")
-            values[key] = value
+            values[_PREFIX.get(section, "") + key] = value
     try:
         return Thresholds(**values)
     except ValueError as err:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +13,7 @@ from .cases import Case
 from .charts import curves_chart, error_chart, representative
 from .compare import W_ACCEPT, Comparison, compare_case
 from .config import Thresholds
+from .goal import goal_rows, goal_section
 from .increments_report import small_contact_section
 from .mdr_report import mdr_section
 from .stability import (
@@ -37,6 +38,7 @@ class ReportResult:
     comparisons: list
     failures: list
     pngs: list
+    goal_misses: list = field(default_factory=list)  # labels of the runs that miss ``[goal]``
 
 
 def worst_point(comp: Comparison, q: str) -> str:
@@ -140,6 +142,9 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
     warned = sorted({w for c in comps for w in c.model_warnings})
     md += ["", "Model warnings while evaluating the validation runs: "
            + ("; ".join(warned) if warned else "none") + "."]
+    goals = goal_rows(comps)
+    if comps:
+        md += ["", "## The design goal", "", *goal_section(goals, th)]
 
     # ------------------------------------------------------------------ tables
     md += ["", f"## The model against each peer law, per class ({W_ACCEPT})", "",
@@ -244,7 +249,8 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            "curves) and where a law does not apply.", ""]
     path = out / "index.md"
     path.write_text("\n".join(md))
-    return ReportResult(path, comps, fails + [f"unloading: {f}" for f in unload_fails], pngs)
+    return ReportResult(path, comps, fails + [f"unloading: {f}" for f in unload_fails], pngs,
+                        [r.label for r in goals if r.misses(th)])
 
 
 def _probe_summary(probes) -> str:
