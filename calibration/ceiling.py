@@ -10,7 +10,10 @@ correction a combination of cubic B-splines in
     ξ = a/R + s n        (s = ``SHIFT``: the FE's c² step lines up in ξ, below)
 
 times the modifiers 1, n, ζ = z/(1 + z) and ln(E/σ_Y)/ln 10⁴ (n the effective exponent,
-z = R/ρ − 1 of the rigid partner). Scores: in-sample, held out
+z = R/ρ − 1 of the rigid partner); ``extra`` adds more (``EXTRA``): the products of those three
+(``pairs``), and the log-log curvature of the flow curve about the representative strain,
+κ = [ln σ_f(4ε)/σ_f(ε) − ln σ_f(ε)/σ_f(ε/4)]/ln 4 at ε = ε_rep (``curvature``: 0 for a power
+law, < 0 where a curve saturates). Scores: in-sample, held out
 over the five folds of materials of the cross-validation (``crossval.material_folds``), and on
 the validation set's single-body points with the correction fitted to all calibration points.
 A term of this kind cannot do better than the in-sample figure; if the held-out one does not
@@ -33,12 +36,14 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import BSpline
 
+from ..model.single import representative_strain
 from .crossval import material_folds
 from .dataset import Dataset
 from .fit import log_errors
 from .forms import point_inputs, predict, raw_curvature_ratio
 
-__all__ = ["SHIFT", "STEP_DEPTH", "basis", "ceiling", "step_positions", "step_law", "main"]
+__all__ = ["SHIFT", "STEP_DEPTH", "EXTRA", "basis", "flow_curvature", "ceiling", "step_positions",
+           "step_law", "main"]
 
 #: ξ = a/R + SHIFT·n: the FE's c² step at ξ ≈ 0.545 for every hardening (``step_law``, v2 database)
 SHIFT = 0.67
@@ -48,21 +53,48 @@ STEP_DEPTH = 0.43
 XI_MAX = 0.9
 #: ridge weight (the basis is a partition of unity: O(1) columns)
 RIDGE = 1e-3
-#: the run error the issue asks for
+#: the run error the model's design goal asks for
 TARGET = 0.03
+#: modifier sets ``basis`` can add to (1, n, ζ, ln E/σ_Y) (module docstring)
+EXTRA = ("pairs", "curvature")
+#: ratio of the strains the flow curve's curvature is read over (ε/k, ε, kε)
+CURVATURE_RATIO = 4.0
 
 
-def basis(ds: Dataset, coeffs, knots: int = 8, shift: float = SHIFT) -> np.ndarray:
-    """Design matrix (points × 4·(knots + 4)): cubic B-splines in ξ (module docstring), each
-    times 1, n, ζ and ln(E/σ_Y)/ln 10⁴."""
+def flow_curvature(ds: Dataset, coeffs, k: float = CURVATURE_RATIO) -> np.ndarray:
+    """κ = [ln σ_f(kε)/σ_f(ε) − ln σ_f(ε)/σ_f(ε/k)]/ln k at ε = ε_rep of every point (0 for a
+    perfectly plastic body)."""
+    eps = representative_strain(ds.x_rho, coeffs.beta, coeffs.beta_growth)[0]
+    out = np.zeros(ds.size)
+    for i, c in enumerate(ds.curves):
+        if math.isinf(c.material.sigma_y):
+            continue
+        m = ds.run == i
+        lo, mid, hi = (c.material.flow_stress(eps[m] * f) for f in (1.0 / k, 1.0, k))
+        out[m] = np.log(hi * lo / mid ** 2) / math.log(k)
+    return out
+
+
+def basis(ds: Dataset, coeffs, knots: int = 8, shift: float = SHIFT, extra=()) -> np.ndarray:
+    """Design matrix (points × columns): cubic B-splines in ξ (module docstring), each times
+    1, n, ζ and ln(E/σ_Y)/ln 10⁴, and the modifiers of ``extra`` (names from ``EXTRA``)."""
+    unknown = set(extra) - set(EXTRA)
+    if unknown:
+        raise ValueError(f"extra must name modifiers among {EXTRA}, got {sorted(unknown)}")
     n = point_inputs(ds, coeffs)[0]
     xi = np.clip(ds.x_R + shift * n, 0.0, XI_MAX * (1 - 1e-12))
     t = np.r_[[0.0] * 4, np.linspace(0.0, XI_MAX, knots + 2)[1:-1], [XI_MAX] * 4]
     B = BSpline.design_matrix(xi, t, 3).toarray()
     z = raw_curvature_ratio(ds)
+    zeta = z / (1.0 + z)
     sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
     lnE = np.log(ds.E_prime / sy) / math.log(1e4)
-    return np.hstack([B * m[:, None] for m in (np.ones_like(xi), n, z / (1.0 + z), lnE)])
+    mods = [np.ones_like(xi), n, zeta, lnE]
+    if "pairs" in extra:
+        mods += [n * zeta, zeta * lnE, n * n, lnE * lnE, n * lnE]
+    if "curvature" in extra:
+        mods.append(flow_curvature(ds, coeffs))
+    return np.hstack([B * m[:, None] for m in mods])
 
 
 def _fit(ds: Dataset, r0: tuple, X: np.ndarray, keep: np.ndarray,
@@ -102,15 +134,15 @@ def _scores(ds: Dataset, rF: np.ndarray, ra: np.ndarray, worst: int = 3) -> dict
 
 
 def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
-            ridge: float = RIDGE) -> dict:
+            ridge: float = RIDGE, extra=()) -> dict:
     """Scores (RMS and max of the F and a errors in %, runs whose larger max exceeds
     ``TARGET``) of the fitted model and of it with the correction: in-sample, held out by
-    folds of materials, and on ``val`` (module docstring)."""
+    folds of materials, and on ``val`` (module docstring; ``extra``: see :func:`basis`)."""
     model = predict(cal, coeffs)
     r0 = _corrected(cal, model)
-    X = basis(cal, coeffs, knots)
+    X = basis(cal, coeffs, knots, extra=extra)
     out = {"parameters": 2 * X.shape[1], "knots": knots, "shift": SHIFT, "ridge": ridge,
-           "model": _scores(cal, *r0)}
+           "extra": list(extra), "model": _scores(cal, *r0)}
     wH, wc = _fit(cal, r0, X, np.ones(cal.size, bool), ridge)
     out["in_sample"] = _scores(cal, *_corrected(cal, model, X @ wH, X @ wc))
     dH, dc = np.empty(cal.size), np.empty(cal.size)
@@ -121,7 +153,7 @@ def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
         dH[test], dc[test] = X[test] @ fH, X[test] @ fc
     out["held_out"] = _scores(cal, *_corrected(cal, model, dH, dc))
     if val is not None:
-        mv, Xv = predict(val, coeffs), basis(val, coeffs, knots)
+        mv, Xv = predict(val, coeffs), basis(val, coeffs, knots, extra=extra)
         out["validation_model"] = _scores(val, *_corrected(val, mv))
         out["validation"] = _scores(val, *_corrected(val, mv, Xv @ wH, Xv @ wc))
     return out
@@ -205,6 +237,9 @@ def main(argv: list[str] | None = None) -> int:
                                   for r, run in db.runs(set=s, status=None, where=one_body)])
                 for s in ("calibration", "validation")}
         result = {k: ceiling(sets["calibration"], co, sets["validation"], k) for k in (6, 8, 12)}
+        for extra in (("curvature",), ("pairs",), EXTRA):  # more modifiers at 8 knots
+            result["8+" + "+".join(extra)] = ceiling(sets["calibration"], co, sets["validation"], 8,
+                                                     extra=extra)
     rows = step_positions(sets["calibration"], co) + step_positions(sets["validation"], co)
     law = step_law(rows)
     out = Path(a.out)

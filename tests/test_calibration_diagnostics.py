@@ -266,3 +266,34 @@ def test_step_positions_and_law_recover_a_planted_step():
     assert len(rows) == len(flats) >= 4
     law = ce.step_law(rows)
     assert law["x0"] == pytest.approx(0.55, abs=0.01) and law["x_n"] == pytest.approx(-0.7, abs=0.05)
+
+
+def test_flow_curvature_sign_and_the_extra_modifiers():
+    """κ is 0 for perfect plasticity, < 0 where a curve saturates (a Voce curve past its
+    linear start), > 0 where linear hardening turns from flat to slope 1; ``extra`` adds its columns and rejects an unknown name."""
+    import dataclasses
+
+    from spherecontact.calibration import ceiling as ce
+    from spherecontact.model import Material
+
+    ds = _exact_ds()
+    eps = np.linspace(0.0, 2.0, 400)
+    voce = Material.from_table(200.0, 0.3, eps, 1.0 + 2.0 * (1.0 - np.exp(-8.0 * eps)))
+    cases = {"pp": Material(200.0, 0.3, 1.0), "voce": voce, "linear": Material(200.0, 0.3, 1.0, 5.0, 1.0)}
+    for name, mat in cases.items():
+        one = dataclasses.replace(ds, curves=[dataclasses.replace(c, material=mat) for c in ds.curves],
+                                  cache={})
+        k = ce.flow_curvature(one, KNOWN_CO)
+        big = one.x_rho > 0.5  # ε_rep ≳ 0.04: Voce saturating, linear hardening past its knee
+        assert big.sum() >= 10
+        if name == "pp":
+            assert np.all(k == 0.0)
+        elif name == "voce":
+            assert np.all(k[big] < -0.05)
+        else:
+            assert np.all(k[big] > 0.02)
+    cols = ce.basis(ds, KNOWN_CO).shape[1]
+    assert ce.basis(ds, KNOWN_CO, extra=("curvature",)).shape[1] == cols * 5 // 4
+    assert ce.basis(ds, KNOWN_CO, extra=ce.EXTRA).shape[1] == cols * 10 // 4
+    with pytest.raises(ValueError, match="extra must name"):
+        ce.basis(ds, KNOWN_CO, extra=("wiggle",))
