@@ -42,8 +42,8 @@ from .dataset import Dataset
 from .fit import log_errors
 from .forms import point_inputs, predict, raw_curvature_ratio
 
-__all__ = ["SHIFT", "STEP_DEPTH", "EXTRA", "basis", "flow_curvature", "ceiling", "step_positions",
-           "step_law", "main"]
+__all__ = ["SHIFT", "STEP_DEPTH", "EXTRA", "basis", "flow_curvature", "ceiling", "learning_curve",
+           "step_positions", "step_law", "main"]
 
 #: ξ = a/R + SHIFT·n: the FE's c² step at ξ ≈ 0.545 for every hardening (``step_law``, v2 database)
 SHIFT = 0.67
@@ -159,6 +159,28 @@ def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
     return out
 
 
+def learning_curve(cal: Dataset, coeffs, folds=(3, 5, 10, 20), knots: int = 8,
+                   ridge: float = RIDGE, extra=()) -> list[dict]:
+    """Held-out scores of the correction against the share of materials it is fitted on: for
+    each k of ``folds``, the materials dealt into k folds (``crossval.material_folds``), each
+    fold predicted from the other k − 1 (a share 1 − 1/k). Scores that stop falling as the
+    share grows say that more runs of the same kind would not take the misfit out."""
+    model = predict(cal, coeffs)
+    r0 = _corrected(cal, model)
+    X = basis(cal, coeffs, knots, extra=extra)
+    groups = np.asarray([c.group for c in cal.curves])[cal.run]
+    out = []
+    for k in folds:
+        dH, dc = np.empty(cal.size), np.empty(cal.size)
+        for held in material_folds(cal.groups, k):
+            test = np.isin(groups, held)
+            fH, fc = _fit(cal, r0, X, ~test, ridge)
+            dH[test], dc[test] = X[test] @ fH, X[test] @ fc
+        out.append({"folds": k, "share_fitted": round(1.0 - 1.0 / k, 3), "parameters": 2 * X.shape[1],
+                    "extra": list(extra), **_scores(cal, *_corrected(cal, model, dH, dc))})
+    return out
+
+
 def step_positions(ds: Dataset, coeffs, lo: float = 0.25, hi: float = 0.7, reach: float = 0.62,
                    depth: float = STEP_DEPTH) -> list[dict]:
     """Flats whose FE c² steps (module docstring): key, a/R of the step, the slope there and n."""
@@ -244,10 +266,11 @@ def main(argv: list[str] | None = None) -> int:
     law = step_law(rows)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    record = {"correction": result, "c2_step": {"law": law, "runs": rows}}
+    curves = [row for extra in ((), EXTRA) for row in learning_curve(sets["calibration"], co, extra=extra)]
+    record = {"correction": result, "learning_curve": curves, "c2_step": {"law": law, "runs": rows}}
     (out / "ceiling.json").write_text(json.dumps(record, indent=1) + "\n")
     _chart(sets["calibration"], co, rows, law, out / "ceiling.png")
-    print(json.dumps({"correction": result, "c2_step": law}, indent=1))
+    print(json.dumps({"correction": result, "learning_curve": curves, "c2_step": law}, indent=1))
     return 0
 
 

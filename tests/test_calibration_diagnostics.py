@@ -297,3 +297,22 @@ def test_flow_curvature_sign_and_the_extra_modifiers():
     assert ce.basis(ds, KNOWN_CO, extra=ce.EXTRA).shape[1] == cols * 10 // 4
     with pytest.raises(ValueError, match="extra must name"):
         ce.basis(ds, KNOWN_CO, extra=("wiggle",))
+
+
+def test_learning_curve_rows_and_a_smooth_misfit_learnt_from_part_of_the_materials():
+    import dataclasses
+
+    from spherecontact.calibration import ceiling as ce
+    from spherecontact.calibration.forms import point_inputs
+
+    ds = _exact_ds()
+    xi = ds.x_R + ce.SHIFT * point_inputs(ds, KNOWN_CO)[0]
+    bent = dataclasses.replace(ds, p_m=ds.p_m * np.exp(0.04 * np.sin(6.0 * xi)), cache={})
+    model_rms = ce.ceiling(bent, KNOWN_CO)["model"]["F_rms_pct"]
+    rows = ce.learning_curve(bent, KNOWN_CO, folds=(2, 4))
+    assert [r["folds"] for r in rows] == [2, 4] and [r["share_fitted"] for r in rows] == [0.5, 0.75]
+    assert all(r["F_rms_pct"] < 0.3 * model_rms for r in rows)
+    offsets = np.random.default_rng(3).choice([-0.03, 0.03], len(ds.curves))
+    noisy = dataclasses.replace(ds, p_m=ds.p_m * np.exp(offsets[ds.run]), cache={})
+    assert all(r["F_rms_pct"] > 0.5 * ce.ceiling(noisy, KNOWN_CO)["model"]["F_rms_pct"]
+               for r in ce.learning_curve(noisy, KNOWN_CO, folds=(2, 4)))
