@@ -270,7 +270,8 @@ def test_step_positions_and_law_recover_a_planted_step():
 
 def test_flow_curvature_sign_and_the_extra_modifiers():
     """κ is 0 for perfect plasticity, < 0 where a curve saturates (a Voce curve past its
-    linear start), > 0 where linear hardening turns from flat to slope 1; ``extra`` adds its columns and rejects an unknown name."""
+    linear start), > 0 where linear hardening turns from flat to slope 1; ``extra`` adds its
+    columns and rejects an unknown name."""
     import dataclasses
 
     from spherecontact.calibration import ceiling as ce
