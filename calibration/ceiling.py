@@ -42,8 +42,8 @@ from .dataset import Dataset
 from .fit import log_errors
 from .forms import point_inputs, predict, raw_curvature_ratio
 
-__all__ = ["SHIFT", "STEP_DEPTH", "EXTRA", "basis", "flow_curvature", "ceiling", "learning_curve",
-           "step_positions", "step_law", "main"]
+__all__ = ["SHIFT", "STEP_DEPTH", "EXTRA", "basis", "flow_curvature", "tensor_basis", "ceiling",
+           "learning_curve", "step_positions", "step_law", "main"]
 
 #: ξ = a/R + SHIFT·n: the FE's c² step at ξ ≈ 0.545 for every hardening (``step_law``, v2 database)
 SHIFT = 0.67
@@ -75,6 +75,13 @@ def flow_curvature(ds: Dataset, coeffs, k: float = CURVATURE_RATIO) -> np.ndarra
     return out
 
 
+def _splines(v, lo: float, hi: float, inner: int, degree: int) -> np.ndarray:
+    """B-splines of ``degree`` on [lo, hi] with ``inner`` equally spaced inner knots at v."""
+    v = np.clip(v, lo, hi - 1e-12 * (hi - lo))
+    t = np.r_[[lo] * (degree + 1), np.linspace(lo, hi, inner + 2)[1:-1], [hi] * (degree + 1)]
+    return BSpline.design_matrix(v, t, degree).toarray()
+
+
 def basis(ds: Dataset, coeffs, knots: int = 8, shift: float = SHIFT, extra=()) -> np.ndarray:
     """Design matrix (points × columns): cubic B-splines in ξ (module docstring), each times
     1, n, ζ and ln(E/σ_Y)/ln 10⁴, and the modifiers of ``extra`` (names from ``EXTRA``)."""
@@ -82,14 +89,12 @@ def basis(ds: Dataset, coeffs, knots: int = 8, shift: float = SHIFT, extra=()) -
     if unknown:
         raise ValueError(f"extra must name modifiers among {EXTRA}, got {sorted(unknown)}")
     n = point_inputs(ds, coeffs)[0]
-    xi = np.clip(ds.x_R + shift * n, 0.0, XI_MAX * (1 - 1e-12))
-    t = np.r_[[0.0] * 4, np.linspace(0.0, XI_MAX, knots + 2)[1:-1], [XI_MAX] * 4]
-    B = BSpline.design_matrix(xi, t, 3).toarray()
+    B = _splines(ds.x_R + shift * n, 0.0, XI_MAX, knots, 3)
     z = raw_curvature_ratio(ds)
     zeta = z / (1.0 + z)
     sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
     lnE = np.log(ds.E_prime / sy) / math.log(1e4)
-    mods = [np.ones_like(xi), n, zeta, lnE]
+    mods = [np.ones_like(n), n, zeta, lnE]
     if "pairs" in extra:
         mods += [n * zeta, zeta * lnE, n * n, lnE * lnE, n * lnE]
     if "curvature" in extra:
@@ -134,13 +139,16 @@ def _scores(ds: Dataset, rF: np.ndarray, ra: np.ndarray, worst: int = 3) -> dict
 
 
 def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
-            ridge: float = RIDGE, extra=()) -> dict:
+            ridge: float = RIDGE, extra=(), design=None) -> dict:
     """Scores (RMS and max of the F and a errors in %, runs whose larger max exceeds
     ``TARGET``) of the fitted model and of it with the correction: in-sample, held out by
-    folds of materials, and on ``val`` (module docstring; ``extra``: see :func:`basis`)."""
+    folds of materials, and on ``val`` (module docstring; ``extra``: see :func:`basis`;
+    ``design(ds, coeffs)``: another design matrix instead, e.g. :func:`tensor_basis`)."""
+    if design is None:
+        design = lambda ds, co: basis(ds, co, knots, extra=extra)  # noqa: E731
     model = predict(cal, coeffs)
     r0 = _corrected(cal, model)
-    X = basis(cal, coeffs, knots, extra=extra)
+    X = design(cal, coeffs)
     out = {"parameters": 2 * X.shape[1], "knots": knots, "shift": SHIFT, "ridge": ridge,
            "extra": list(extra), "model": _scores(cal, *r0)}
     wH, wc = _fit(cal, r0, X, np.ones(cal.size, bool), ridge)
@@ -153,10 +161,35 @@ def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
         dH[test], dc[test] = X[test] @ fH, X[test] @ fc
     out["held_out"] = _scores(cal, *_corrected(cal, model, dH, dc))
     if val is not None:
-        mv, Xv = predict(val, coeffs), basis(val, coeffs, knots, extra=extra)
+        mv, Xv = predict(val, coeffs), design(val, coeffs)
         out["validation_model"] = _scores(val, *_corrected(val, mv))
         out["validation"] = _scores(val, *_corrected(val, mv, Xv @ wH, Xv @ wc))
     return out
+
+
+#: the tensor-product correction (:func:`tensor_basis`): cubic B-splines in ξ with 8 inner knots
+#: on [0, XI_MAX], quadratic ones with one inner knot in n on [0, 0.5] and in log₁₀ E/σ_Y on
+#: [1, 4.2], each times (1, ζ), (1, κ) and (1, ν)
+TENSOR_RIDGE = 0.1
+
+
+def tensor_basis(ds: Dataset, coeffs) -> np.ndarray:
+    """Tensor-product design matrix (points × 12·4·4·2·2·2 = 1536): every product of the
+    splines in ξ, n and log₁₀ E/σ_Y and of (1, ζ), (1, κ), (1, ν) (``TENSOR_RIDGE``'s comment):
+    a correction table that can follow any interaction of the model's variables, the limit
+    of what a table in them could give."""
+    n = point_inputs(ds, coeffs)[0]
+    z = raw_curvature_ratio(ds)
+    sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
+    nu = np.asarray([c.material.nu for c in ds.curves])[ds.run]
+    one = np.ones(ds.size)
+    factors = [_splines(ds.x_R + SHIFT * n, 0.0, XI_MAX, 8, 3), _splines(n, 0.0, 0.5, 1, 2),
+               _splines(np.log10(ds.E_prime / sy), 1.0, 4.2, 1, 2), np.c_[one, z / (1.0 + z)],
+               np.c_[one, flow_curvature(ds, coeffs)], np.c_[one, nu]]
+    X = factors[0]
+    for M in factors[1:]:
+        X = (X[:, :, None] * M[:, None, :]).reshape(ds.size, -1)
+    return X
 
 
 def learning_curve(cal: Dataset, coeffs, folds=(3, 5, 10, 20), knots: int = 8,
@@ -262,6 +295,8 @@ def main(argv: list[str] | None = None) -> int:
         for extra in (("curvature",), ("pairs",), EXTRA):  # more modifiers at 8 knots
             result["8+" + "+".join(extra)] = ceiling(sets["calibration"], co, sets["validation"], 8,
                                                      extra=extra)
+        result["tensor"] = ceiling(sets["calibration"], co, sets["validation"], ridge=TENSOR_RIDGE,
+                                   design=tensor_basis)
     rows = step_positions(sets["calibration"], co) + step_positions(sets["validation"], co)
     law = step_law(rows)
     out = Path(a.out)

@@ -317,3 +317,26 @@ def test_learning_curve_rows_and_a_smooth_misfit_learnt_from_part_of_the_materia
     noisy = dataclasses.replace(ds, p_m=ds.p_m * np.exp(offsets[ds.run]), cache={})
     assert all(r["F_rms_pct"] > 0.5 * ce.ceiling(noisy, KNOWN_CO)["model"]["F_rms_pct"]
                for r in ce.learning_curve(noisy, KNOWN_CO, folds=(2, 4)))
+
+
+def test_tensor_basis_shape_and_a_misfit_that_couples_xi_and_stiffness():
+    """The tensor table follows a misfit whose shape in ξ changes with E/σY (a product the
+    modifiers of ``basis`` hold only linearly)."""
+    import dataclasses
+
+    from spherecontact.calibration import ceiling as ce
+    from spherecontact.calibration.forms import point_inputs
+
+    ds = _exact_ds()
+    X = ce.tensor_basis(ds, KNOWN_CO)
+    assert X.shape == (ds.size, 12 * 4 * 4 * 2 * 2 * 2)
+    n = point_inputs(ds, KNOWN_CO)[0]
+    xi = ds.x_R + ce.SHIFT * n
+    sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
+    e = np.log10(ds.E_prime / sy)
+    bent = dataclasses.replace(ds, p_m=ds.p_m * np.exp(0.04 * np.sin(6.0 * xi) * (e - 2.5) ** 2 / 2),
+                               cache={})
+    r = ce.ceiling(bent, KNOWN_CO, ridge=ce.TENSOR_RIDGE, design=ce.tensor_basis)
+    assert r["parameters"] == 2 * X.shape[1] and r["model"]["F_rms_pct"] > 0.5
+    assert r["in_sample"]["F_rms_pct"] < 0.2 * r["model"]["F_rms_pct"]
+    assert ce.ceiling(bent, KNOWN_CO)["in_sample"]["F_rms_pct"] > 0.3 * r["model"]["F_rms_pct"]
