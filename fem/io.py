@@ -72,7 +72,7 @@ from ..model.material import Material
 from ..model.sphere import Sphere
 from .assembly import ELEMENTS
 from .contact import RigidObstacle
-from .mesh import DENSITY_RANGE, EDGE_BAND_MAX, check_band_floor
+from .mesh import DENSITY_RANGE, check_band_floor, check_edge_band
 from .solver import (
     IndentationSolver,
     RunResult,
@@ -274,10 +274,7 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
         raise ValueError(f"mesh density must lie in [{lo:g}, {hi:g}], got {density!r}")
     if element not in ELEMENTS:
         raise ValueError(f"element must be one of {sorted(ELEMENTS)}, got {element!r}")
-    band = _as_float(edge_band)
-    if not (math.isfinite(band) and 0.0 <= band <= EDGE_BAND_MAX):
-        raise ValueError(f"edge_band must lie in [0, {EDGE_BAND_MAX:g}] (0: no surface band), "
-                         f"got {edge_band!r}")
+    band = check_edge_band(edge_band)
     floor = check_band_floor(band_floor, band)
     options = SolverOptions() if options is None else options
     if not isinstance(options, SolverOptions):

@@ -226,8 +226,7 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
         raise ValueError(f"radius must be a finite number > 0, got {radius!r}")
     density = check_density(density)
     scale = radius if contact_scale is None else min(float(contact_scale), radius)
-    if not (np.isfinite(edge_band) and 0.0 <= edge_band <= EDGE_BAND_MAX):
-        raise ValueError(f"edge_band must lie in [0, {EDGE_BAND_MAX}] (0: off), got {edge_band!r}")
+    edge_band = check_edge_band(edge_band)
     floor = check_band_floor(band_floor, edge_band)
     Xg, tg = _gmsh_quad8(radius, density, linear, scale, float(edge_band), floor)
     if linear:
@@ -256,6 +255,19 @@ def build_mesh(radius: float = 1.0, density: float = 1.0, linear: bool = False,
     return HemisphereMesh(mesh=mesh, X=X, surface=surface, axis=axis, equator=equator,
                           radius=radius, density=density, edge_band=float(edge_band),
                           band_floor=floor)
+
+
+def check_edge_band(edge_band) -> float:
+    """The surface band's ratio of element size to distance from the pole, checked against
+    [0, ``EDGE_BAND_MAX``] (0: no band, the default mesh)."""
+    try:
+        band = float(edge_band)
+    except (TypeError, ValueError):
+        band = math.nan
+    if not (math.isfinite(band) and 0.0 <= band <= EDGE_BAND_MAX):
+        raise ValueError(f"edge_band must lie in [0, {EDGE_BAND_MAX:g}] (0: no surface band), "
+                         f"got {edge_band!r}")
+    return band
 
 
 def check_band_floor(band_floor, edge_band: float) -> float:

@@ -40,7 +40,7 @@ import numpy as np
 from ..data import Database
 from .design import load_campaign
 from .io import run_indentation
-from .mesh import EDGE_BAND_MAX, check_band_floor
+from .mesh import check_band_floor, check_edge_band
 from .reproduce import compare_loading
 from .solver import SolverOptions, iteration_split
 from .verification_pair import HERTZ_PAIR, hertz_figures
@@ -149,10 +149,13 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if not 0 <= args.interleave <= 10:
         ap.error(f"--interleave must be in [0, 10], got {args.interleave}")
-    if args.edge_band is not None:
-        if not 0.0 < args.edge_band <= EDGE_BAND_MAX:
-            ap.error(f"--edge-band must be in (0, {EDGE_BAND_MAX:g}], got {args.edge_band}")
-        try:  # the mesh's own check, before any run
+    if args.edge_band is not None:  # the mesh's own checks, before any run
+        try:
+            if check_edge_band(args.edge_band) == 0.0:
+                raise ValueError("edge_band 0 is the stored runs' mesh: leave --edge-band out")
+        except ValueError as err:
+            ap.error(f"--edge-band: {err}")
+        try:
             check_band_floor(args.band_floor, args.edge_band)
         except ValueError as err:
             ap.error(f"--band-floor: {err}")

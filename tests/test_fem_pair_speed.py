@@ -67,6 +67,7 @@ def test_a_surface_band_given_applies_to_the_pair_and_its_flat_run_alike():
 
 
 @pytest.mark.parametrize("args, word", [(["--edge-band", "0.5"], "--edge-band"),
+                                        (["--edge-band", "0"], "--edge-band"),
                                         (["--edge-band", "0.03", "--band-floor", "0"], "--band-floor"),
                                         (["--edge-band", "0.03", "--band-floor", "0.05"], "--band-floor"),
                                         (["--interleave", "11"], "--interleave")])
