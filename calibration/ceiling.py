@@ -37,7 +37,7 @@ import numpy as np
 from scipy.interpolate import BSpline
 
 from ..model.single import representative_strain
-from .crossval import material_folds
+from .crossval import FOLDS, material_folds
 from .dataset import Dataset
 from .fit import log_errors
 from .forms import point_inputs, predict, raw_curvature_ratio
@@ -82,18 +82,23 @@ def _splines(v, lo: float, hi: float, inner: int, degree: int) -> np.ndarray:
     return BSpline.design_matrix(v, t, degree).toarray()
 
 
+def _variables(ds: Dataset, coeffs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """n (the effective exponent), ζ = z/(1 + z) of the rigid partner and E'/σ_Y at every point."""
+    n = point_inputs(ds, coeffs)[0]
+    z = raw_curvature_ratio(ds)
+    sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
+    return n, z / (1.0 + z), ds.E_prime / sy
+
+
 def basis(ds: Dataset, coeffs, knots: int = 8, shift: float = SHIFT, extra=()) -> np.ndarray:
     """Design matrix (points × columns): cubic B-splines in ξ (module docstring), each times
     1, n, ζ and ln(E/σ_Y)/ln 10⁴, and the modifiers of ``extra`` (names from ``EXTRA``)."""
     unknown = set(extra) - set(EXTRA)
     if unknown:
         raise ValueError(f"extra must name modifiers among {EXTRA}, got {sorted(unknown)}")
-    n = point_inputs(ds, coeffs)[0]
+    n, zeta, stiffness = _variables(ds, coeffs)
     B = _splines(ds.x_R + shift * n, 0.0, XI_MAX, knots, 3)
-    z = raw_curvature_ratio(ds)
-    zeta = z / (1.0 + z)
-    sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
-    lnE = np.log(ds.E_prime / sy) / math.log(1e4)
+    lnE = np.log(stiffness) / math.log(1e4)
     mods = [np.ones_like(n), n, zeta, lnE]
     if "pairs" in extra:
         mods += [n * zeta, zeta * lnE, n * n, lnE * lnE, n * lnE]
@@ -112,6 +117,19 @@ def _fit(ds: Dataset, r0: tuple, X: np.ndarray, keep: np.ndarray,
     w = np.linalg.solve(A.T @ A + ridge * np.eye(A.shape[1]), A.T @ np.r_[rF[keep], ra[keep]])
     k = X.shape[1]
     return w[:k], w[k:]
+
+
+def _held_out(cal: Dataset, r0: tuple, X: np.ndarray, ridge: float,
+              folds: int = FOLDS) -> tuple[np.ndarray, np.ndarray]:
+    """The ln H̄ and ln c² corrections at every point, each fold of materials
+    (``crossval.material_folds``) predicted by the correction fitted to the others."""
+    dH, dc = np.empty(cal.size), np.empty(cal.size)
+    groups = np.asarray([c.group for c in cal.curves])[cal.run]
+    for held in material_folds(cal.groups, folds):
+        test = np.isin(groups, held)
+        fH, fc = _fit(cal, r0, X, ~test, ridge)
+        dH[test], dc[test] = X[test] @ fH, X[test] @ fc
+    return dH, dc
 
 
 def _corrected(ds: Dataset, model: tuple, dH=0.0, dc=0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -153,13 +171,7 @@ def ceiling(cal: Dataset, coeffs, val: Dataset | None = None, knots: int = 8,
            "extra": list(extra), "model": _scores(cal, *r0)}
     wH, wc = _fit(cal, r0, X, np.ones(cal.size, bool), ridge)
     out["in_sample"] = _scores(cal, *_corrected(cal, model, X @ wH, X @ wc))
-    dH, dc = np.empty(cal.size), np.empty(cal.size)
-    groups = np.asarray([c.group for c in cal.curves])[cal.run]
-    for held in material_folds(cal.groups):
-        test = np.isin(groups, held)
-        fH, fc = _fit(cal, r0, X, ~test, ridge)
-        dH[test], dc[test] = X[test] @ fH, X[test] @ fc
-    out["held_out"] = _scores(cal, *_corrected(cal, model, dH, dc))
+    out["held_out"] = _scores(cal, *_corrected(cal, model, *_held_out(cal, r0, X, ridge)))
     if val is not None:
         mv, Xv = predict(val, coeffs), design(val, coeffs)
         out["validation_model"] = _scores(val, *_corrected(val, mv))
@@ -178,13 +190,11 @@ def tensor_basis(ds: Dataset, coeffs) -> np.ndarray:
     splines in ξ, n and log₁₀ E/σ_Y and of (1, ζ), (1, κ), (1, ν) (``TENSOR_RIDGE``'s comment):
     a correction table that can follow any interaction of the model's variables, the limit
     of what a table in them could give."""
-    n = point_inputs(ds, coeffs)[0]
-    z = raw_curvature_ratio(ds)
-    sy = np.asarray([c.material.sigma_y for c in ds.curves])[ds.run]
+    n, zeta, stiffness = _variables(ds, coeffs)
     nu = np.asarray([c.material.nu for c in ds.curves])[ds.run]
     one = np.ones(ds.size)
     factors = [_splines(ds.x_R + SHIFT * n, 0.0, XI_MAX, 8, 3), _splines(n, 0.0, 0.5, 1, 2),
-               _splines(np.log10(ds.E_prime / sy), 1.0, 4.2, 1, 2), np.c_[one, z / (1.0 + z)],
+               _splines(np.log10(stiffness), 1.0, 4.2, 1, 2), np.c_[one, zeta],
                np.c_[one, flow_curvature(ds, coeffs)], np.c_[one, nu]]
     X = factors[0]
     for M in factors[1:]:
@@ -201,17 +211,9 @@ def learning_curve(cal: Dataset, coeffs, folds=(3, 5, 10, 20), knots: int = 8,
     model = predict(cal, coeffs)
     r0 = _corrected(cal, model)
     X = basis(cal, coeffs, knots, extra=extra)
-    groups = np.asarray([c.group for c in cal.curves])[cal.run]
-    out = []
-    for k in folds:
-        dH, dc = np.empty(cal.size), np.empty(cal.size)
-        for held in material_folds(cal.groups, k):
-            test = np.isin(groups, held)
-            fH, fc = _fit(cal, r0, X, ~test, ridge)
-            dH[test], dc[test] = X[test] @ fH, X[test] @ fc
-        out.append({"folds": k, "share_fitted": round(1.0 - 1.0 / k, 3), "parameters": 2 * X.shape[1],
-                    "extra": list(extra), **_scores(cal, *_corrected(cal, model, dH, dc))})
-    return out
+    return [{"folds": k, "share_fitted": round(1.0 - 1.0 / k, 3), "parameters": 2 * X.shape[1],
+             "extra": list(extra), **_scores(cal, *_corrected(cal, model, *_held_out(cal, r0, X, ridge, k)))}
+            for k in folds]
 
 
 def step_positions(ds: Dataset, coeffs, lo: float = 0.25, hi: float = 0.7, reach: float = 0.62,
