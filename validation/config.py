@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 __all__ = ["Thresholds", "load_thresholds"]
@@ -50,9 +50,7 @@ class Thresholds:
     goal_split_max: float = 0.05
 
     def __post_init__(self) -> None:
-        for name in ("h_over_R_max", "h_over_R_large_max", "large_deformation_from", "a_min_over_R",
-                     "F_max", "a_max", "F_branch_max", "h_res_max", "goal_F_max", "goal_a_max",
-                     "goal_rms_max", "goal_split_max"):
+        for name in (f.name for f in fields(self)):  # every threshold is a positive number
             v = getattr(self, name)
             if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
                 raise ValueError(f"threshold {name} must be a finite number > 0, got {v!r}")

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from .compare import W_ACCEPT, Comparison
 from .config import Thresholds
 from .metrics import EMPTY, Summary, relative_error, smooth_loglog, summarise, trapezoid_weights
+from .tables import pct
 
 __all__ = ["GoalRow", "goal_rows", "goal_section"]
 
@@ -60,10 +61,6 @@ def goal_rows(comps: list[Comparison]) -> list[GoalRow]:
     return rows
 
 
-def _pct(x: float) -> str:
-    return "—" if x != x else f"{100 * x:.1f}"
-
-
 def goal_section(rows: list[GoalRow], th: Thresholds) -> list[str]:
     """Markdown lines: the count of runs that miss the goal, raw and smoothed, and the table of
     those that miss it."""
@@ -81,7 +78,7 @@ def goal_section(rows: list[GoalRow], th: Thresholds) -> list[str]:
         lines += ["", "| run | misses | F max (rms) % | a max (rms) % | F / a max % against smoothed FE "
                   "| split max (pp) |", "|---|---|---|---|---|---|"]
         for r in sorted(raw, key=lambda r: -max(r.F.max, r.a.max)):
-            lines.append(f"| {r.label} | {', '.join(r.misses(th))} | {_pct(r.F.max)} ({_pct(r.F.rms)}) "
-                         f"| {_pct(r.a.max)} ({_pct(r.a.rms)}) | {_pct(r.F_smooth.max)} / "
-                         f"{_pct(r.a_smooth.max)} | {_pct(r.split)} |")
+            lines.append(f"| {r.label} | {', '.join(r.misses(th))} | {pct(r.F.max)} ({pct(r.F.rms)}) "
+                         f"| {pct(r.a.max)} ({pct(r.a.rms)}) | {pct(r.F_smooth.max)} / "
+                         f"{pct(r.a_smooth.max)} | {pct(r.split)} |")
     return lines
