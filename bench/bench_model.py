@@ -76,7 +76,7 @@ def range_check_overhead(co, n: int = 100_000) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("error", CalibrationRangeWarning)  # the pair and h are in range
         law = ContactLaw(s1, s2, coeffs=co)
-        t_force = _best(lambda: law.force(h), 20)
+        t_force = _best(lambda: law.loading_force(h), 20)
         t_check = _best(lambda: law._table_causes(h), 20)
         t_setup = _best(lambda: ContactLaw(s1, s2, coeffs=co), 5)
         t_thresholds = _best(law._range_thresholds, 5)
@@ -112,8 +112,8 @@ def main() -> dict:
     for name, pair in (("fast_equal_pair", equal), ("fast_dissimilar_pair", dissimilar)):
         setups, law = _setups(pair, co)
         laws[name] = law
-        law.force(h)
-        t_fast = _best(lambda law=law: law.force(h))
+        law.loading_force(h)
+        t_fast = _best(lambda law=law: law.loading_force(h))
         out[name] = {
             "setup_s_median": float(np.median(setups)),
             "setup_s_max": float(np.max(setups)),
@@ -137,8 +137,8 @@ def main() -> dict:
     jackson_green(h, R, Ep, STEEL.sigma_y, STEEL.nu)
     t_jg = _best(lambda: jackson_green(h, R, Ep, STEEL.sigma_y, STEEL.nu))
     wall = ContactLaw(Sphere(R, STEEL), Sphere(math.inf, Material.rigid()), coeffs=co)
-    wall.force(h)
-    t_wall = _best(lambda: wall.force(h))
+    wall.loading_force(h)
+    t_wall = _best(lambda: wall.loading_force(h))
     out["jackson_green_2005_formula"] = {"seconds": t_jg, "contacts_per_s": N / t_jg}
     out["fast_rigid_flat"] = {"seconds": t_wall, "contacts_per_s": N / t_wall,
                               "setup_s": wall.setup_time}

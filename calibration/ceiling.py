@@ -282,7 +282,7 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m spherecontact.calibration.ceiling",
                                 description=__doc__.split("\n\n")[0])
     p.add_argument("--db", default="data/reference_v2.h5")
-    p.add_argument("--coefficients", default="data/coefficients.json")
+    p.add_argument("--coefficients", default="model/coefficients.json")
     p.add_argument("--out", default="reports/calibration")
     a = p.parse_args(argv)
     co = load_coefficients(a.coefficients)

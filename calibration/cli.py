@@ -23,7 +23,7 @@ def build_parser() -> argparse.ArgumentParser:
                     "form by cross-validation over five folds of held-out materials; write the "
                     "coefficient file and the report.")
     p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
-    p.add_argument("--out", default="data/coefficients.json", help="coefficient file to write")
+    p.add_argument("--out", default="model/coefficients.json", help="coefficient file to write")
     p.add_argument("--report", default="reports/calibration", metavar="DIR",
                    help="report directory (index.md + PNG); '' for none")
     p.add_argument("--forms", default=",".join(CANDIDATES),

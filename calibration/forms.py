@@ -3,7 +3,7 @@
 Every candidate is a restriction of the model's coefficient schema
 (``model/README.md``), so whatever is fitted is evaluated by the model's own code
 (:func:`predict` calls ``spherecontact.model.single.BodyLaw``) and can be written to
-``data/coefficients.json`` as it is.
+``model/coefficients.json`` as it is.
 
 Free parameters of a form (bounds in :func:`Form.parameters`):
 

@@ -2,7 +2,7 @@
 
 :func:`calibrate_runs` works on ``(key, run)`` pairs (tests use synthetic runs);
 :func:`calibrate` opens the reference database through its reader API
-(``spherecontact.data.Database``) and writes ``data/coefficients.json``.
+(``spherecontact.data.Database``) and writes ``model/coefficients.json``.
 
 Choice of the form, by the numbers: every candidate of ``forms.CANDIDATES`` is fitted
 and cross-validated (``crossval``: five folds of held-out materials); the chosen form has the smallest
@@ -454,7 +454,7 @@ def calibrated_range(ds: Dataset, coeffs: Coefficients) -> dict:
 
 
 def coefficient_file(cal: Calibration) -> dict:
-    """The schema-2 dictionary written to ``data/coefficients.json``."""
+    """The schema-2 dictionary written to ``model/coefficients.json``."""
     best = cal.best
     d = json.loads(json.dumps(best.coeff_dict))
     ds = cal.dataset

@@ -487,7 +487,7 @@ def _markdown(cal: Calibration, charts: list[str]) -> str:
     L.append("## Continuity and monotonicity of F(h)\n")
     bad = [c for c in cal.checks if not c.ok]
     L.append(f"{len(cal.checks)} pairs (every calibration material as equal spheres and on a rigid "
-             "flat; a grid of E/σY 3–3·10⁴, ν 0.2/0.45, perfectly plastic to K/σY = 10, on a flat and "
+             "flat; a grid of E/σY 5–3·10⁴, ν 0.2/0.45, perfectly plastic to K/σY = 10, on a flat and "
              "against a rigid sphere; dissimilar pairs; a tabulated flow curve), contact radius "
              f"1e-6 R … 0.95 R in steps of 0.2 %, then approach h 1e-5 R … 0.9 R in steps of 0.2 % "
              f"(the state `contact()` gives): {len(cal.checks) - len(bad)} pass "

@@ -10,15 +10,17 @@ converged part is still written, flagged ``stopped`` with its reason).
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 import textwrap
 from pathlib import Path
 
-import numpy as np
-
-from ..model.material import Material
+from ..model.cli_args import (
+    material2_from_args,
+    material_from_args,
+    output_path,
+    read_flow_table,
+)
 from .assembly import ELEMENTS
 from .contact import EDGE_FITS
 from .io import SCENES, check_inputs, run_indentation, write_run
@@ -31,79 +33,9 @@ __all__ = ["register", "run_command", "render_command", "read_flow_table", "mate
 
 #: exit code of a run that stopped before h_max (file written, status "stopped")
 EXIT_STOPPED = 3
+#: file names of a run file (HDF5)
+RUN_SUFFIXES = (".h5", ".hdf5")
 _DEFAULTS = SolverOptions()
-
-
-def read_flow_table(path) -> tuple[np.ndarray, np.ndarray]:
-    """Two-column CSV (eps_p, sigma); an optional header line and ``#`` comments allowed."""
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as err:
-        raise ValueError(f"--flow-table: cannot read {path}: {err.strerror or err}") from None
-    rows = []
-    for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
-        cells = [c.strip() for c in row if c.strip()]
-        if not cells or cells[0].startswith("#"):
-            continue
-        if len(cells) != 2:
-            raise ValueError(f"--flow-table {path}, line {lineno}: expected two columns "
-                             f"eps_p, sigma, got {len(cells)}")
-        try:
-            rows.append((float(cells[0]), float(cells[1])))
-        except ValueError:
-            if rows:  # only the first non-comment line may be a header
-                raise ValueError(f"--flow-table {path}, line {lineno}: not a number: "
-                                 f"{','.join(cells)!r}") from None
-    if not rows:
-        raise ValueError(f"--flow-table {path}: no data rows")
-    table = np.array(rows)
-    return table[:, 0], table[:, 1]
-
-
-def material_from_args(args: argparse.Namespace) -> Material:
-    """Material from --E/--nu and either --sigma-y/--K/--n or --flow-table."""
-    if args.flow_table is not None:
-        given = [f for f, v in (("--sigma-y", args.sigma_y), ("--K", args.K), ("--n", args.n))
-                 if v is not None]
-        if given:
-            raise ValueError(f"--flow-table replaces --sigma-y/--K/--n; drop {', '.join(given)}")
-        eps, sigma = read_flow_table(args.flow_table)
-        try:
-            return Material.from_table(args.E, args.nu, eps, sigma)
-        except ValueError as err:
-            raise ValueError(f"--flow-table {args.flow_table}: {err}") from None
-    return Material(E=args.E, nu=args.nu,
-                    sigma_y=math.inf if args.sigma_y is None else args.sigma_y,
-                    K=0.0 if args.K is None else args.K, n=1.0 if args.n is None else args.n)
-
-
-BODY2_FLAGS = {"radius2": "--radius2", "E2": "--E2", "nu2": "--nu2", "sigma_y2": "--sigma-y2",
-               "K2": "--K2", "n2": "--n2"}
-
-
-def material2_from_args(args: argparse.Namespace, material: Material) -> Material | None:
-    """Body 2 from --E2/--nu2/--sigma-y2/--K2/--n2 (each defaults to body 1's value);
-    None when no body-2 flag is given. --E2 inf makes body 2 rigid."""
-    given = {k: getattr(args, k, None) for k in BODY2_FLAGS}
-    if all(v is None for v in given.values()):
-        return None
-    E2 = args.E if given["E2"] is None else given["E2"]
-    nu2 = args.nu if given["nu2"] is None else given["nu2"]
-    if math.isinf(E2) and E2 > 0:
-        return Material.rigid()
-    plastic = [given[k] for k in ("sigma_y2", "K2", "n2")]
-    if material.is_tabulated and all(v is None for v in plastic):
-        return Material.from_table(E2, nu2, material.eps_table, material.sigma_table)
-    if material.is_tabulated:
-        defaults = (math.inf, 0.0, 1.0)
-    else:
-        defaults = (material.sigma_y, material.K, material.n)
-    sy, K, n = (d if v is None else v for v, d in zip(plastic, defaults, strict=True))
-    try:
-        return Material(E=E2, nu=nu2, sigma_y=sy, K=K, n=n)
-    except ValueError as err:
-        raise ValueError(f"body 2 (--E2/--nu2/--sigma-y2/--K2/--n2): {err}") from None
 
 
 def options_from_args(args: argparse.Namespace) -> SolverOptions:
@@ -117,16 +49,6 @@ def options_from_args(args: argparse.Namespace) -> SolverOptions:
                          segment_points=args.segment_points, segment_scheme=args.segment_scheme,
                          penalty_scale=args.penalty_scale, linear_solver=args.linear_solver,
                          definite_shift=args.definite_shift, edge_fit=args.edge_fit)
-
-
-def _check_output(out) -> Path:
-    """The output path: its directory must exist, and it must not be a directory."""
-    path = Path(out)
-    if path.is_dir():
-        raise ValueError(f"--out {out} is a directory; give a file name such as run.h5")
-    if not path.parent.is_dir():
-        raise ValueError(f"--out: directory {path.parent} does not exist")
-    return path
 
 
 class _Progress:
@@ -166,7 +88,7 @@ def run_command(args: argparse.Namespace) -> int:
     """CLI handler of ``fem run``: validate, run, write, summarise; return the exit code."""
     material = material_from_args(args)
     options = options_from_args(args)
-    out = _check_output(args.out)
+    out = output_path(args.out, RUN_SUFFIXES)
     material2 = material2_from_args(args, material)
     radius2 = args.radius2
     if material2 is not None and radius2 is None:
@@ -244,6 +166,8 @@ def _add_geometry(add) -> None:
     add(grp2, "--sigma-y2", type=float, default=None, help="yield stress of body 2, > 0")
     add(grp2, "--K2", type=float, default=None, help="Ludwik hardening modulus of body 2, >= 0")
     add(grp2, "--n2", type=float, default=None, help="Ludwik hardening exponent of body 2, >= 0")
+    add(grp2, "--flow-table2", metavar="FILE.csv", default=None,
+        help="tabulated flow curve of body 2 instead of --sigma-y2/--K2/--n2 (format of --flow-table)")
     add(grp2, "--scene", choices=("auto", "two-body"), default="auto",
         help="auto (default): the cheapest exact scene (rigid partner: one hemisphere on a rigid "
              "flat or sphere; equal bodies: one hemisphere on a flat by symmetry; otherwise two "

@@ -6,6 +6,9 @@ flat, ``--E2 inf`` a rigid body. ``--unload`` appends the unloading branch from 
 residual approach (column ``branch``: 0 load, 1 unload) and the cycle's residual approach,
 energies and quasi-static restitution coefficient (``cycle.py``).
 
+Body flags as ``fem run``'s (``cli_args.py``): ``--flow-table`` / ``--flow-table2`` for a
+tabulated flow curve of either body.
+
 ``table``: the fast path's table of the pair (``ContactLaw.tables``) as a NumPy ``.npz`` of plain
 arrays, for a particle (DEM) code to evaluate ``force(h, h_max)`` without this package
 (:func:`write_table`).
@@ -21,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .cli_args import material2_from_args, material_from_args, output_path
 from .coefficients import default_coefficients, load_coefficients
 from .contact import contact
 from .cycle import cycle
 from .fast import ContactLaw
-from .material import Material
 from .sphere import Sphere
 
 __all__ = ["register", "curve", "run_curve", "write_table", "run_table", "TABLE_FORMAT",
@@ -37,12 +40,6 @@ TABLE_FORMAT = "spherecontact-contact-table/1"
 CHECK_POINTS = 16
 
 COLUMNS = ("h", "F", "a", "h1", "h2", "stiffness")
-
-
-def _material(E, nu, sigma_y, K, n) -> Material:
-    if math.isinf(E):
-        return Material.rigid(nu=nu)
-    return Material(E=E, nu=nu, sigma_y=sigma_y, K=K, n=n)
 
 
 def curve(s1: Sphere, s2: Sphere, h_max: float, points: int = 50, coeffs=None,
@@ -77,19 +74,14 @@ def curve(s1: Sphere, s2: Sphere, h_max: float, points: int = 50, coeffs=None,
 
 def _pair(args: argparse.Namespace) -> tuple[Sphere, Sphere]:
     """The two spheres of the command line (body 2's missing values are body 1's)."""
-    m1 = _material(args.E, args.nu, args.sigma_y, args.K, args.n)
-    m2 = _material(
-        args.E if args.E2 is None else args.E2,
-        args.nu if args.nu2 is None else args.nu2,
-        args.sigma_y if args.sigma_y2 is None else args.sigma_y2,
-        args.K if args.K2 is None else args.K2,
-        args.n if args.n2 is None else args.n2,
-    )
+    m1 = material_from_args(args)
+    m2 = material2_from_args(args, m1) or m1
     s1 = Sphere(radius=args.radius, material=m1)
     return s1, Sphere(radius=args.radius if args.radius2 is None else args.radius2, material=m2)
 
 
 def _coefficients(args: argparse.Namespace):
+    """``--coefficients``: a file, ``literature`` (the uncalibrated set, by name) or the default."""
     return load_coefficients(args.coefficients) if args.coefficients else default_coefficients()
 
 
@@ -176,8 +168,7 @@ def _write_text(path, arrays: dict) -> None:
 
 def run_table(args: argparse.Namespace) -> int:
     """CLI handler of ``model table``."""
-    if not str(args.out).endswith(TABLE_SUFFIXES):
-        raise SystemExit(f"--out must name a {' or '.join(TABLE_SUFFIXES)} file, got {args.out!r}")
+    output_path(args.out, TABLE_SUFFIXES)
     s1, s2 = _pair(args)
     arrays = write_table(s1, s2, args.out, args.h_max, _coefficients(args))
     meta = json.loads(str(arrays["meta"]))
@@ -189,6 +180,8 @@ def run_table(args: argparse.Namespace) -> int:
 
 def run_curve(args: argparse.Namespace) -> int:
     """CLI handler of ``model curve``."""
+    if args.out:
+        output_path(args.out)
     s1, s2 = _pair(args)
     m1, m2 = s1.material, s2.material
     coeffs = _coefficients(args)
@@ -219,13 +212,16 @@ def run_curve(args: argparse.Namespace) -> int:
 
 
 def _body_arguments(p) -> None:
-    g1 = p.add_argument_group("body 1")
+    g1 = p.add_argument_group("body 1 (consistent units: stresses in the unit of E)")
     g1.add_argument("--E", type=float, required=True, help="Young's modulus (inf: rigid)")
     g1.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio (default 0.3)")
-    g1.add_argument("--sigma-y", type=float, default=math.inf,
-                    help="yield stress (default inf: elastic)")
-    g1.add_argument("--K", type=float, default=0.0, help="Ludwik hardening modulus (default 0)")
-    g1.add_argument("--n", type=float, default=1.0, help="Ludwik hardening exponent (default 1)")
+    g1.add_argument("--sigma-y", type=float, default=None,
+                    help="yield stress (default: none, an elastic body)")
+    g1.add_argument("--K", type=float, default=None, help="Ludwik hardening modulus (default 0)")
+    g1.add_argument("--n", type=float, default=None, help="Ludwik hardening exponent (default 1)")
+    g1.add_argument("--flow-table", metavar="FILE.csv", default=None,
+                    help="tabulated flow curve instead of --sigma-y/--K/--n: two CSV columns eps_p, "
+                         "sigma (optional header, '#' comments)")
     g1.add_argument("--radius", type=float, required=True, help="radius (inf: flat)")
     g2 = p.add_argument_group("body 2 (defaults: same as body 1)")
     g2.add_argument("--E2", type=float)
@@ -233,8 +229,11 @@ def _body_arguments(p) -> None:
     g2.add_argument("--sigma-y2", type=float)
     g2.add_argument("--K2", type=float)
     g2.add_argument("--n2", type=float)
+    g2.add_argument("--flow-table2", metavar="FILE.csv", help="tabulated flow curve of body 2")
     g2.add_argument("--radius2", type=float)
-    p.add_argument("--coefficients", help="coefficient JSON file (default data/coefficients.json)")
+    p.add_argument("--coefficients", metavar="FILE.json|literature",
+                   help="coefficient file (default: the calibrated set shipped with the package); "
+                        "'literature' for the uncalibrated literature set")
 
 
 def register(subparsers) -> None:

@@ -1,9 +1,12 @@
 """Coefficient set of the level functions H̄(Λ), c²(Λ) (DESIGN §2), stored as versioned JSON.
 
-The set is read from ``data/coefficients.json`` (the ``SPHERECONTACT_COEFFICIENTS``
-environment variable names another file); calibration writes it with
-``"source": "calibration"``. If the shipped file is missing, the built-in literature
-set :data:`LITERATURE` (schema 1) is used. The JSON schema is documented in
+The default set is the calibrated file ``coefficients.json`` shipped inside this package
+(``model/coefficients.json`` in the repository, read with :mod:`importlib.resources`, so a
+wheel, an sdist and an editable install read the same file); ``make calibrate`` writes it
+with ``"source": "calibration"``. The ``SPHERECONTACT_COEFFICIENTS`` environment variable
+names another file. The built-in literature set :data:`LITERATURE` (schema 1) is used only
+when asked for by name, ``load_coefficients("literature")``; a missing or unreadable default
+file is an error, never a silent fallback. The JSON schema is documented in
 ``model/README.md``.
 
 Functional forms fixed by the schema (symbols of DESIGN §1–2):
@@ -88,6 +91,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -102,6 +106,7 @@ __all__ = [
     "LITERATURE",
     "Coefficients",
     "default_path",
+    "package_path",
     "load_coefficients",
     "default_coefficients",
 ]
@@ -124,8 +129,8 @@ PRESSURE_PROFILES = ("hertz", "flattened")
 EXPONENT_WINDOW_RANGE = (1.5, 10.0)
 EXPONENT_CAP_RANGE = (0.1, 2.0)
 
-#: Built-in literature set (schema 1): the starting values of calibration and the fallback
-#: when ``data/coefficients.json`` is missing.
+#: Built-in literature set (schema 1): the starting values of calibration, used by name only
+#: (``load_coefficients("literature")``).
 LITERATURE: dict = {
     "schema_version": 1,
     "source": "literature",
@@ -1053,33 +1058,63 @@ class Coefficients:
         return self.collapse_sharpness if kc is None else kc
 
 
+#: file name of the calibrated set inside the package (``model/coefficients.json``)
+PACKAGE_FILE = "coefficients.json"
+#: name that selects :data:`LITERATURE` in :func:`load_coefficients` and ``--coefficients``
+LITERATURE_NAME = "literature"
+
+
+def package_path() -> Path:
+    """The calibrated coefficient file shipped inside the package (``model/coefficients.json``)."""
+    return Path(str(resources.files(__package__).joinpath(PACKAGE_FILE)))
+
+
 def default_path() -> Path:
-    """``$SPHERECONTACT_COEFFICIENTS`` if set, else ``<repo>/data/coefficients.json``."""
+    """``$SPHERECONTACT_COEFFICIENTS`` if set, else the packaged file (:func:`package_path`)."""
     env = os.environ.get(ENV_VAR)
-    if env:
-        return Path(env)
-    return Path(__file__).resolve().parents[1] / "data" / "coefficients.json"
+    return Path(env) if env else package_path()
 
 
 def load_coefficients(path: str | os.PathLike | None = None) -> Coefficients:
-    """Load and validate a coefficient file.
+    """Load and validate a coefficient set.
 
-    With ``path=None`` the default location is used (:func:`default_path`); if that
-    file does not exist and no environment override is set, the built-in
-    :data:`LITERATURE` set is returned. An explicitly named file that is missing,
-    is not JSON, or fails validation raises ValueError.
+    Parameters
+    ----------
+    path : a coefficient JSON file; ``"literature"`` for the built-in literature set
+        :data:`LITERATURE`; ``None`` for the default (:func:`default_path`: the calibrated file
+        shipped with the package, or ``$SPHERECONTACT_COEFFICIENTS``).
+
+    Raises
+    ------
+    ValueError
+        The file is missing, is not JSON or fails validation; for the default file the
+        message says how to restore it.
     """
-    explicit = path is not None or bool(os.environ.get(ENV_VAR))
-    p = Path(path) if path is not None else default_path()
-    if not p.exists():
-        if explicit:
-            raise ValueError(f"coefficients: file not found: {p}")
+    if path is not None and str(path) == LITERATURE_NAME:
         return Coefficients.from_dict(LITERATURE)
+    p = Path(path) if path is not None else default_path()
     try:
-        d = json.loads(p.read_text())
+        text = p.read_text()
+    except OSError as err:
+        raise ValueError(_unreadable(p, path, err.strerror or str(err))) from None
+    try:
+        d = json.loads(text)
     except json.JSONDecodeError as err:
-        raise ValueError(f"coefficients: {p} is not valid JSON ({err})") from err
+        raise ValueError(_unreadable(p, path, f"not valid JSON: {err}")) from None
     return Coefficients.from_dict(d)
+
+
+def _unreadable(p: Path, path, why: str) -> str:
+    """Message for a coefficient file that cannot be read; the default one says how to restore it."""
+    if path is not None:
+        return f"coefficients: cannot read {p}: {why}"
+    if os.environ.get(ENV_VAR):
+        return (f"coefficients: cannot read {p} named by ${ENV_VAR}: {why}; unset {ENV_VAR} to use "
+                "the calibrated set shipped with the package")
+    return (f"coefficients: the calibrated set shipped with the package, {p}, cannot be read: {why}. "
+            "Reinstall spherecontact (pip install --force-reinstall spherecontact), or in a "
+            "checkout restore it with `git checkout model/coefficients.json` or `make calibrate`; "
+            "load_coefficients(\"literature\") gives the uncalibrated literature set by name")
 
 
 @lru_cache(maxsize=4)
@@ -1090,5 +1125,8 @@ def _cached_default(path_key: str, mtime: float) -> Coefficients:
 def default_coefficients() -> Coefficients:
     """The default coefficient set, re-read when the file or the env override changes."""
     p = default_path()
-    mtime = p.stat().st_mtime if p.exists() else -1.0
+    try:
+        mtime = p.stat().st_mtime
+    except OSError:
+        mtime = -1.0  # load_coefficients raises the error that says how to restore it
     return _cached_default(str(p), mtime)

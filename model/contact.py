@@ -112,7 +112,7 @@ def contact(s1: Sphere, s2: Sphere, h, coeffs: Coefficients | None = None,
     ----------
     s1, s2 : spheres (``radius=math.inf`` for a flat, ``Material.rigid()`` for a rigid body).
     h : approach of the two centres, float or array of any shape; h ≤ 0 is no contact.
-    coeffs : coefficient set; default ``data/coefficients.json``.
+    coeffs : coefficient set; default ``model/coefficients.json``.
     h_max : largest approach reached before (scalar or shaped like h, ≥ 0); default h itself
         (monotone loading). Where h ≥ h_max the state is on the loading curve (loading past
         the previous maximum); below it on the elastic unloading/reloading branch of the

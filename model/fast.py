@@ -171,7 +171,7 @@ class ContactLaw:
         most ``h_limit``.
     h_min : smallest approach tabulated; default 1e-10·R*. Below it and above h_max
         the exact solve is used.
-    coeffs : coefficient set; default ``data/coefficients.json``.
+    coeffs : coefficient set; default ``model/coefficients.json``.
     rtol : target relative interpolation error of F, a and dF/dh.
 
     Attributes
@@ -784,7 +784,7 @@ class ContactLaw:
             F[low], k[low] = 0.0, 0.0
             pos = low & (h > 0.0)                  # 0 < h < h_min: the exact solve
             if pos.any():
-                F[pos], k[pos] = self.force(h[pos])
+                F[pos], k[pos] = self.loading_force(h[pos])
         return F, k
 
     def _unload(self, h, hm, full: bool = False):
@@ -811,39 +811,53 @@ class ContactLaw:
                 st = self(h[elastic])
                 F[elastic], k[elastic], a[elastic], h1[elastic] = st.F, st.stiffness, st.a, st.h1
             else:
-                F[elastic], k[elastic] = self.force(h[elastic])
+                F[elastic], k[elastic] = self.loading_force(h[elastic])
         return (F, k, a, h1) if full else (F, k)
 
-    def force(self, h, h_max=None):
-        """Contact force F and stiffness dF/dh for approaches h (any shape; h ≤ 0: zeros).
+    def force(self, h, h_max):
+        """Contact force F and stiffness dF/dh for approaches h with their history.
 
         The hot path for DEM: interpolation for h in [h_min, h_max], exact solve outside.
-        ``h_max``: the largest approach each contact has reached before (scalar or shaped like
-        h; default h, monotone loading): below it the contact is on its unloading/reloading
-        branch (``unloading.py``; F = 0 at and below the residual approach), at or above it on
-        the loading curve. Keep the history with ``np.maximum(h_max, h)`` after each step.
+
+        Parameters
+        ----------
+        h : approaches (any shape; h ≤ 0: no contact, zeros).
+        h_max : the largest approach each contact has reached before (scalar or shaped like
+            h). Below it the contact is on its unloading/reloading branch (``unloading.py``;
+            F = 0 at and below the residual approach), at or above it on the loading curve.
+            Keep the history with ``np.maximum(h_max, h)`` after each step; for a first
+            loading without history use :meth:`loading_force`.
+
+        Returns
+        -------
+        F, dF/dh : arrays shaped like h (floats for a scalar h).
         """
-        if h_max is not None:
-            hh = as_approach(h)
-            hm = as_history(h_max, hh.shape).reshape(-1)
-            flat = hh.reshape(-1)
-            fast = self._force_history(flat, hm)
-            if fast is not None:
-                F, k = fast
-                found = self._table_causes(np.array([flat.max(), hm.max()]) if flat.size else flat)
-                if found:
-                    self._report(found)
-                F, k = F.reshape(hh.shape), k.reshape(hh.shape)
-                return (F[()], k[()]) if hh.ndim == 0 else (F, k)
-            below = flat < hm  # some contact needs the exact solve: loading and unloading apart
-            F = np.zeros(flat.shape)
-            k = np.zeros(flat.shape)
-            F[below], k[below] = self._unload(flat[below], hm[below])
-            up = ~below
-            if up.any():
-                F[up], k[up] = self.force(flat[up])
+        hh = as_approach(h)
+        hm = as_history(h_max, hh.shape).reshape(-1)
+        flat = hh.reshape(-1)
+        fast = self._force_history(flat, hm)
+        if fast is not None:
+            F, k = fast
+            found = self._table_causes(np.array([flat.max(), hm.max()]) if flat.size else flat)
+            if found:
+                self._report(found)
             F, k = F.reshape(hh.shape), k.reshape(hh.shape)
             return (F[()], k[()]) if hh.ndim == 0 else (F, k)
+        below = flat < hm  # some contact needs the exact solve: loading and unloading apart
+        F = np.zeros(flat.shape)
+        k = np.zeros(flat.shape)
+        F[below], k[below] = self._unload(flat[below], hm[below])
+        up = ~below
+        if up.any():
+            F[up], k[up] = self.loading_force(flat[up])
+        F, k = F.reshape(hh.shape), k.reshape(hh.shape)
+        return (F[()], k[()]) if hh.ndim == 0 else (F, k)
+
+    def loading_force(self, h):
+        """F and dF/dh on the first loading curve (every contact at its largest approach so far).
+
+        The same as ``force(h, h_max=h)``; a contact that has unloaded needs :meth:`force`.
+        """
         hh = as_approach(h)
         flat = hh.reshape(-1)
         inside = (flat >= self.h_min) & (flat <= self.h_max)

@@ -21,9 +21,25 @@ import numpy as np
 
 __all__ = ["Material"]
 
+#: allowed E/σ_Y (and E over a flow table's first stress): outside it the two are almost surely
+#: in different units (E in GPa and σ_Y in Pa gives 1e-9 of the true ratio, MPa against Pa 1e6 times)
+E_OVER_SIGMA_Y_RANGE = (5.0, 1e6)
+#: largest plastic strain a flow table may reach: beyond it the strains are likely in per cent
+EPS_TABLE_MAX = 5.0
+
 #: Ludwik slope K n ε^(n-1) is infinite at ε_p = 0 for n < 1; it is evaluated at
 #: max(ε_p, EPS_SLOPE_FLOOR) so that Newton solvers get a large but finite slope.
 EPS_SLOPE_FLOOR = 1e-12
+
+
+def check_stress_units(E: float, stress: float, name: str) -> None:
+    """Refuse E/stress outside ``E_OVER_SIGMA_Y_RANGE`` (a units slip), naming ``name``."""
+    lo, hi = E_OVER_SIGMA_Y_RANGE
+    if math.isfinite(E) and not lo <= E / stress <= hi:
+        raise ValueError(
+            f"E/{name.split(' ')[0]} = {E / stress:.4g} (E = {E:g}, {name} = {stress:g}) lies outside "
+            f"[{lo:g}, {hi:g}]: E and the stress are likely in different units (e.g. E in GPa and "
+            f"the stress in Pa); give both in the same unit")
 
 
 def _check_finite(name: str, value: float) -> float:
@@ -41,15 +57,22 @@ class Material:
     ----------
     E : Young's modulus, > 0 (``math.inf`` for a rigid body: use ``Material.rigid()``).
     nu : Poisson's ratio, in (-1, 0.5).
-    sigma_y : initial yield stress σ_Y, > 0.
+    sigma_y : initial yield stress σ_Y, > 0, with E/σ_Y in ``E_OVER_SIGMA_Y_RANGE`` (required:
+        an elastic body is ``Material.elastic(E, nu)``).
     K : Ludwik hardening modulus, >= 0 (0: perfectly plastic).
-    n : Ludwik hardening exponent, >= 0.
+    n : Ludwik hardening exponent, > 0 when K > 0 (n = 0 would be a yield jump to σ_Y + K).
     eps_table, sigma_table : tabulated flow curve (use ``Material.from_table``).
+
+    Raises
+    ------
+    ValueError
+        naming the parameter, its value and the allowed range; for E/σ_Y outside
+        ``E_OVER_SIGMA_Y_RANGE`` the likely cause (E and σ_Y in different units).
     """
 
     E: float
     nu: float
-    sigma_y: float = math.inf
+    sigma_y: float
     K: float = 0.0
     n: float = 1.0
     eps_table: tuple[float, ...] | None = field(default=None, repr=False)
@@ -76,6 +99,13 @@ class Material:
                 raise ValueError(f"K (Ludwik hardening modulus) must be >= 0, got {K!r}")
             if n < 0.0:
                 raise ValueError(f"n (Ludwik hardening exponent) must be >= 0, got {n!r}")
+            if n == 0.0 and K > 0.0:
+                raise ValueError(
+                    f"n = 0 with K = {K!r} > 0 makes the flow stress jump from sigma_y = {sy!r} to "
+                    f"sigma_y + K = {sy + K!r} at the first plastic strain; for a perfectly plastic "
+                    f"material write sigma_y = {sy + K!r}, K = 0 (or give n > 0 for hardening)")
+        if math.isfinite(sy):
+            check_stress_units(E, sy, "sigma_y")
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -104,6 +134,11 @@ class Material:
             raise ValueError(f"sigma must be > 0, got sigma[0] = {sig[0]!r}")
         if np.any(np.diff(sig) < 0.0):
             raise ValueError("sigma must be non-decreasing (a monotone flow curve)")
+        if eps[-1] > EPS_TABLE_MAX:
+            raise ValueError(
+                f"eps_p reaches {eps[-1]:g}, above {EPS_TABLE_MAX:g}: plastic strains look like per "
+                f"cent; give them as fractions (e.g. 0.2, not 20)")
+        check_stress_units(float(E), float(sig[0]), "sigma[0] (the flow table's first stress)")
         return cls(
             E=E, nu=nu, sigma_y=float(sig[0]), K=0.0, n=1.0,
             eps_table=tuple(eps.tolist()), sigma_table=tuple(sig.tolist()),
@@ -112,7 +147,7 @@ class Material:
     @classmethod
     def rigid(cls, nu: float = 0.3) -> Material:
         """A rigid body: E = ∞, E' = ∞."""
-        return cls(E=math.inf, nu=nu)
+        return cls(E=math.inf, nu=nu, sigma_y=math.inf)
 
     @classmethod
     def elastic(cls, E: float, nu: float) -> Material:

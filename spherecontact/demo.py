@@ -5,7 +5,7 @@
 An elastic–perfectly plastic sphere (σ_Y = 1, R = 1, ν = 0.3) pressed on a rigid
 flat — by symmetry one of two equal spheres in contact. The FE solver writes
 its run file (``OUT/run.h5``); the closed-form model (coefficients from
-``data/coefficients.json``), Hertz and Jackson & Green (2005) are evaluated at the
+``model/coefficients.json``), Hertz and Jackson & Green (2005) are evaluated at the
 same approaches; ``OUT/index.md`` holds the table and ``OUT/curves.png`` the chart.
 """
 

@@ -185,13 +185,13 @@ STABLE_RMS_FE = 0.01
 @pytest.mark.skipif(not SHIPPED_DB.exists(), reason="data/reference_v2.h5 (the FE reference "
                     "database) is not present; the synthetic-database version of this test runs")
 def test_dropping_a_material_keeps_the_fit_stable_on_the_shipped_database():
-    coeffs = load_coefficients(ROOT / "data" / "coefficients.json")
+    coeffs = load_coefficients(ROOT / "model" / "coefficients.json")
     if coeffs.source != "calibration":
-        pytest.skip("data/coefficients.json is not a calibration yet")
+        pytest.skip("model/coefficients.json is not a calibration yet")
     runs, source = load_runs(SHIPPED_DB)
     if source["calibration_runs_hash"] != coeffs.provenance.get("fe_dataset", {}).get(
             "calibration_runs_hash"):
-        pytest.skip("data/coefficients.json was calibrated on other calibration runs")
+        pytest.skip("model/coefficients.json was calibrated on other calibration runs")
     ds = build_dataset(runs)
     form = FORMS[coeffs.provenance["form"]["name"]]
     full = fit(ds, form)

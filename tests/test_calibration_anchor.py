@@ -9,7 +9,7 @@ from spherecontact.model import Material, Sphere, contact, load_coefficients
 
 
 def test_anchor_rows_are_the_models_elastic_sphere_against_the_fe():
-    m = Material(E=1000.0, nu=0.3)  # elastic
+    m = Material.elastic(E=1000.0, nu=0.3)  # elastic
     flat = Sphere(np.inf, Material.rigid())
     h = np.array([p[0] for p in ELASTIC_SPHERE])
     target = np.array([p[1] for p in ELASTIC_SPHERE])

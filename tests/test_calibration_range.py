@@ -22,7 +22,7 @@ from spherecontact.model.single import effective_exponent, hardening_magnitude
 
 ROOT = Path(__file__).resolve().parents[1]
 SHIPPED_DB = ROOT / "data" / "reference_v2.h5"
-SHIPPED = ROOT / "data" / "coefficients.json"
+SHIPPED = ROOT / "model" / "coefficients.json"
 #: the keys ``model/`` reads, in this shape (written by calibration)
 KEYS = {"E_over_sigma_y", "nu", "hardening_n", "h_over_R_max", "a_over_R_max", "Lambda",
         "K_over_sigma_y", "R_over_R_rigid"}
@@ -113,10 +113,10 @@ def test_calibrated_range_covers_a_dataset_of_other_runs():
 def test_shipped_file_records_the_range_of_its_calibration_runs():
     d = json.loads(SHIPPED.read_text())
     if d.get("source") != "calibration":
-        pytest.skip("data/coefficients.json is not a calibration yet")
+        pytest.skip("model/coefficients.json is not a calibration yet")
     runs, source = load_runs(SHIPPED_DB)
     if source["calibration_runs_hash"] != d["provenance"]["fe_dataset"]["calibration_runs_hash"]:
-        pytest.skip("data/coefficients.json was calibrated on other calibration runs")
+        pytest.skip("model/coefficients.json was calibrated on other calibration runs")
     ds = build_dataset(runs)
     _assert_matches(d["provenance"]["calibrated_range"], _expected(ds, d["beta"], d.get("beta_growth", 0.0),
                                                                      d.get("strain_spread", 0.0),

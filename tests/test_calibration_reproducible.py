@@ -129,5 +129,5 @@ def test_shipped_coefficients_name_the_shipped_database():
     from spherecontact.data import Database
 
     root = Path(__file__).resolve().parents[1]
-    prov = json.loads((root / "data" / "coefficients.json").read_text())["provenance"]["fe_dataset"]
+    prov = json.loads((root / "model" / "coefficients.json").read_text())["provenance"]["fe_dataset"]
     assert prov["content_hash"] == Database(SHIPPED_DB).content_hash

@@ -123,7 +123,7 @@ def test_model_with_collapse_hertz_limit_and_fast_path(ratio):
         law = ContactLaw(Sphere(R, m), s2, coeffs=co, h_max=0.4)
         assert law.error["F"] < 1e-6
         hs = np.geomspace(1e-6, 0.3, 50)
-        F, k = law.force(hs)
+        F, k = law.loading_force(hs)
         assert np.all(np.diff(F) > 0) and np.all(k > 0)
 
 
@@ -190,5 +190,5 @@ def test_curvature_ratio_of_the_pair():
     assert 0.9 < p._z[id(p.law1)] < 1.0 and -1.0 < p._z[id(p.law2)] < -0.9
     # the κ equation stays monotone: F(h) continuous and increasing for a dissimilar pair
     law = ContactLaw(Sphere(1.0, m), Sphere(2.0, hard), coeffs=co, h_max=0.4)
-    F, k = law.force(np.geomspace(1e-6, 0.35, 200))
+    F, k = law.loading_force(np.geomspace(1e-6, 0.35, 200))
     assert np.all(np.diff(F) > 0) and np.all(k > 0)

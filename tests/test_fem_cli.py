@@ -190,3 +190,20 @@ def test_solver_option_flags_reach_the_options():
     default = options_from_args(build_parser().parse_args(
         ["fem", "run", "--E", "200", "--h-max", "0.1", "--out", "x.h5"]))
     assert default.line_search is True and default.max_wall_s == float("inf")
+
+
+def test_body_2_takes_its_own_flow_table(tmp_path):
+    """``fem run --flow-table2``: body 2 of a two-body run is the tabulated material, checked like
+    body 1's; body 1's flow curve is untouched."""
+    from spherecontact.cli import build_parser, join_negative_values
+    from spherecontact.model.cli_args import material2_from_args, material_from_args
+
+    table = tmp_path / "alu.csv"
+    table.write_text("eps_p,sigma\n0,1.2\n0.02,1.6\n0.4,2.3\n")
+    args = build_parser().parse_args(join_negative_values(
+        ["fem", "run", *EPP, "--E2", "70", "--nu2", "0.33", "--flow-table2", str(table),
+         "--h-max", "0.01", "--out", str(tmp_path / "r.h5")]))
+    m1 = material_from_args(args)
+    m2 = material2_from_args(args, m1)
+    assert m1 == Material(E=200.0, nu=0.3, sigma_y=1.0)
+    assert m2 == Material.from_table(70.0, 0.33, [0.0, 0.02, 0.4], [1.2, 1.6, 2.3])

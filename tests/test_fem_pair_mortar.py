@@ -135,7 +135,7 @@ def test_elastic_mortar_pair_is_hertz_and_splits_as_hertz_with_either_body_as_sl
     point (0.55 at most, nodal contact 0.3). F(h) with the stiffer body as slave lies up to 1.3 %
     below (contact 3–6 surface nodes wide: its master, the soft body, takes the Catmull–Rom loads
     of the test above)."""
-    m1, m2 = Material(E=200.0, nu=0.3, sigma_y=1e9), Material(E=600.0, nu=0.2, sigma_y=1e9)
+    m1, m2 = Material.elastic(E=200.0, nu=0.3), Material.elastic(E=600.0, nu=0.2)
     opts = SolverOptions(penalty=3000.0, penalty_scale="approach", segment_points=2, segment_scheme="mortar")
     runs = []
     for which in (0, 1):

@@ -313,7 +313,7 @@ def test_segment_contact_carries_the_load_of_nodal_contact_and_keeps_hertz():
     from spherecontact.fem.twobody import SegmentPairWarning, TwoBodySolver
     from spherecontact.model.material import Material
 
-    m1, m2 = Material(E=200.0, nu=0.3, sigma_y=1e9), Material(E=600.0, nu=0.2, sigma_y=1e9)
+    m1, m2 = Material.elastic(E=200.0, nu=0.3), Material.elastic(E=600.0, nu=0.2)
     runs = {}
     for n in (0, 3):
         opts = SolverOptions(penalty=3000.0, penalty_scale="approach", segment_points=n)

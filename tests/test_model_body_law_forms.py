@@ -72,7 +72,7 @@ def test_logistic_weight_is_the_two_branch_formula_bit_for_bit():
     Material(E=200.0, nu=0.3, sigma_y=1.0),
     Material(E=1e3, nu=0.3, sigma_y=1.0, K=5.0, n=0.3),
     Material.from_table(E=200.0, nu=0.3, eps_p=[0.0, 0.02, 0.1, 0.5], sigma=[1.0, 1.3, 1.6, 2.0]),
-    Material(E=1.0, nu=0.3),  # elastic
+    Material.elastic(E=1.0, nu=0.3),  # elastic
 ])
 @pytest.mark.parametrize("with_xc", [False, True])
 def test_pressure_only_response_is_the_full_responses_pressure(material, with_xc):

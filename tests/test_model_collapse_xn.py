@@ -194,7 +194,7 @@ def test_two_body_stiffness_and_table_with_the_new_terms(ratio, s2):
         np.testing.assert_allclose((mid.dlnh_dlna * fda)[smooth], 1.0, rtol=2e-5)
         law = ContactLaw(s1, s2, coeffs=co, h_max=0.4)
         assert law.error["F"] < 1e-6
-        F, k = law.force(h)
+        F, k = law.loading_force(h)
         np.testing.assert_allclose(F, mid.F, rtol=1e-6)
         np.testing.assert_allclose(k[smooth], mid.stiffness[smooth], rtol=1e-5)
 

@@ -260,7 +260,7 @@ def test_the_fast_path_stops_its_table_before_the_plastic_limit():
     law = ContactLaw(s1, s2)
     assert 0.35 * s2.radius < law.h_limit < 0.45 * s2.radius and law.h_max == law.h_limit
     h = s2.radius * np.linspace(0.01, 0.5, 40)
-    F, k = law.force(h)
+    F, k = law.loading_force(h)
     st = contact(s1, s2, h)
     assert law.error["F"] < 1e-6
     np.testing.assert_array_less(np.abs(F / st.F - 1.0), law.error["F"])  # within its own bounds

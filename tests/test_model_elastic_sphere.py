@@ -18,7 +18,7 @@ H_CHECK = np.array([0.002, 0.01, 0.03, 0.05, 0.08, 0.1, 0.15])
 
 
 def _fe_elastic_sphere():
-    m = Material(E=200.0, nu=0.3, sigma_y=1e9)  # no point yields
+    m = Material.elastic(E=200.0, nu=0.3)  # no point yields
     res = run_indentation(m, 1.0, 0.15, edge_band=0.03)
     assert res.status == "converged"
     return m, np.asarray(res.curves["h"]), np.asarray(res.curves["F"]), np.asarray(res.curves["a"])

@@ -43,10 +43,10 @@ def test_table_error_is_bounded_against_exact_solve(name):
     assert rel("a") <= law.error["a"]
     assert rel("stiffness") <= law.error["stiffness"]
     assert np.max(np.abs(fa.h1 - ex.h1) / h) <= max(law.error["h1"], 1e-12)
-    F, k = law.force(h)
+    F, k = law.loading_force(h)
     assert np.array_equal(F, fa.F) and np.array_equal(k, fa.stiffness)
     hs = np.sort(h)
-    assert np.all(np.diff(law.force(hs)[0]) >= 0)
+    assert np.all(np.diff(law.loading_force(hs)[0]) >= 0)
 
 
 def test_setup_time_and_fallback_outside_table():
@@ -56,12 +56,12 @@ def test_setup_time_and_fallback_outside_table():
     law = contact_table(s1, s2, h_max=0.2 * R, coeffs=CO)
     assert time.perf_counter() - t0 < 0.25  # target 50 ms; generous on a loaded machine
     h = np.array([-1.0, 0.0, 1e-16, 0.1 * R, 0.4 * R])
-    F, k = law.force(h)
+    F, k = law.loading_force(h)
     ex = contact(s1, s2, h, CO)
     assert F[0] == 0.0 and F[1] == 0.0 and k[0] == 0.0
     assert np.allclose(F[2:], ex.F[2:], rtol=1e-6)
     assert np.allclose(law(h).a, ex.a, rtol=1e-6)
-    assert np.ndim(law.force(1e-5)[0]) == 0
+    assert np.ndim(law.loading_force(1e-5)[0]) == 0
 
 
 def test_bad_table_arguments():
@@ -86,7 +86,7 @@ def test_cli_curve_json_and_csv(tmp_path, capsys):
                          "--h-max", "1e-4", "--points", "5", "--json"])
     assert args.func(args) == 0
     out = json.loads(capsys.readouterr().out)
-    # the source of the default set: "literature" until calibration writes data/coefficients.json
+    # the source of the default set: "literature" until calibration writes model/coefficients.json
     assert len(out["F"]) == 5
     assert out["meta"]["coefficients_source"] == default_coefficients().source
     ref = contact(Sphere(1e-3, STEEL), Sphere(2e-3, Material(E=70e9, nu=0.33, sigma_y=100e6,
@@ -167,7 +167,7 @@ def test_two_kinks_in_one_grid_step_are_both_found():
     wall = Sphere(math.inf, Material.rigid())
     law = contact_table(Sphere(1.0, m), wall, h_max=0.3, coeffs=CO)
     h = np.geomspace(1e-4, 0.3, 3000)
-    F, k = law.force(h)
+    F, k = law.loading_force(h)
     exact = contact(Sphere(1.0, m), wall, h, coeffs=CO)
     assert law.error["stiffness"] <= 1e-6
     np.testing.assert_allclose(k, exact.stiffness, rtol=2e-6)
@@ -297,7 +297,7 @@ def test_refinement_is_local_and_keeps_the_error_bound():
     assert law.nodes < 1.2 * coarse
     assert max(law.error["F"], law.error["a"], law.error["stiffness"]) <= law.rtol
     h = np.geomspace(law.h_min * 1.01, law.h_max * 0.99, 20001)
-    F, _ = law.force(h)
+    F, _ = law.loading_force(h)
     assert np.max(np.abs(F / contact(s1, s2, h, co).F - 1.0)) <= law.error["F"]
 
 

@@ -55,7 +55,8 @@ def test_the_check_along_h_catches_the_ill_posed_pair_and_the_coupling_mends_it(
                                   "equal_E_yield_ratio_1.02"])
 def test_interface_terms_leave_other_pairs_alone(pair):
     s1, s2 = {
-        "elastic": (Sphere(1.0, Material(E=1.0, nu=0.3)), Sphere(2.0, Material(E=3.0, nu=0.25))),
+        "elastic": (Sphere(1.0, Material.elastic(E=1.0, nu=0.3)),
+                    Sphere(2.0, Material.elastic(E=3.0, nu=0.25))),
         "equal_material_radii_2": (Sphere(1.0, SOFT), Sphere(2.0, SOFT)),
         "yield_ratio_1.5": (Sphere(1.0, SOFT), Sphere(1.0, Material(E=900.0, nu=0.3, sigma_y=1.5))),
         # equal moduli: no modulus-driven run-away to correct (radius ratio 2 and 4 of the FE
@@ -94,7 +95,7 @@ def test_fast_path_tabulates_the_coupled_pair():
     law = ContactLaw(Sphere(1.0, SOFT), Sphere(1.0, STIFF), coeffs=CO, h_max=0.3)
     assert law.error["F"] < 1e-6
     h = np.geomspace(1e-4, 0.3, 200)
-    F, k = law.force(h)
+    F, k = law.loading_force(h)
     ex = contact(Sphere(1.0, SOFT), Sphere(1.0, STIFF), h, CO)
     np.testing.assert_allclose(F, ex.F, rtol=1e-6)
 

@@ -30,11 +30,13 @@ def test_shipped_file_is_valid_and_the_literature_set_still_reads():
     assert CO.source == "literature" and CO.schema_version == 1
 
 
-def test_missing_file_falls_back_to_literature(tmp_path, monkeypatch):
+def test_missing_default_file_is_an_error_not_the_literature_set(tmp_path, monkeypatch):
     monkeypatch.setattr(
         "spherecontact.model.coefficients.default_path", lambda: tmp_path / "absent.json"
     )
-    assert load_coefficients() == CO
+    with pytest.raises(ValueError, match=r"absent\.json.*Reinstall.*make calibrate"):
+        load_coefficients()
+    assert load_coefficients("literature") == CO
 
 
 def test_env_override(tmp_path, monkeypatch):
@@ -47,7 +49,7 @@ def test_env_override(tmp_path, monkeypatch):
     co = load_coefficients()
     assert co.beta == 0.2 and co.source == "calibration"
     monkeypatch.setenv("SPHERECONTACT_COEFFICIENTS", str(tmp_path / "nope.json"))
-    with pytest.raises(ValueError, match="not found"):
+    with pytest.raises(ValueError, match=r"cannot read .*nope\.json named by \$SPHERECONTACT_COEFFICIENTS"):
         load_coefficients()
 
 

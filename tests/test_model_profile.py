@@ -43,8 +43,8 @@ def test_factor_values_and_slope():
 def test_elastic_body_under_a_fully_plastic_partner_takes_the_uniform_fraction():
     """At one p_m and a the elastic body's approach is 8/(3π) of the Hertz value once the
     partner is fully plastic (level weight 1); the plastic body's share rises accordingly."""
-    soft, elastic = Sphere(1.0, Material(E=10000.0, nu=0.3, sigma_y=1.0)), Sphere(1.0, Material(E=300.0,
-                                                                                             nu=0.3))
+    soft = Sphere(1.0, Material(E=10000.0, nu=0.3, sigma_y=1.0))
+    elastic = Sphere(1.0, Material.elastic(E=300.0, nu=0.3))
     a = np.array([0.15, 0.2])
     for co in (HERTZ, FLAT):
         p = pair(soft, elastic, co)
@@ -84,7 +84,7 @@ def test_fast_path_tabulates_it():
     s1, s2 = Sphere(1.0, SOFT), Sphere(2.0, HARD)
     law = ContactLaw(s1, s2, coeffs=FLAT, h_max=0.3)
     h = np.geomspace(1e-4, 0.3, 200)
-    F, _ = law.force(h)
+    F, _ = law.loading_force(h)
     np.testing.assert_allclose(F, contact(s1, s2, h, FLAT).F, rtol=1e-5)
 
 

@@ -36,7 +36,7 @@ def materials(draw):
         sig = sy * np.cumprod([1.0, *[1 + i for i in inc]])
         return Material.from_table(E=E, nu=nu, eps_p=eps, sigma=sig)
     return Material(E=E, nu=nu, sigma_y=sy, K=sy * draw(st.floats(0.0, 10.0)),
-                    n=draw(st.floats(0.0, 1.0)))
+                    n=draw(st.floats(0.0, 1.0, exclude_min=True)))
 
 
 @st.composite

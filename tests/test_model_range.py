@@ -41,8 +41,8 @@ IN_RANGE = {
 
 # name: (s1, s2, h, pattern the warning must match)
 OUT_OF_RANGE = {
-    "E_over_sigma_y_low": (Sphere(1.0, Material(E=2.5, nu=0.3, sigma_y=1.0)), FLAT, H_IN,
-                           r"E/sigma_y = 2\.5 of sphere 1 is outside the calibrated range \[10, 10000\]"),
+    "E_over_sigma_y_low": (Sphere(1.0, Material(E=6.0, nu=0.3, sigma_y=1.0)), FLAT, H_IN,
+                           r"E/sigma_y = 6 of sphere 1 is outside the calibrated range \[10, 10000\]"),
     "E_over_sigma_y_high": (Sphere(1.0, Material(E=1e5, nu=0.3, sigma_y=1.0)), FLAT, H_IN,
                             r"E/sigma_y = 100000 of sphere 1 .*\[10, 10000\]"),
     "nu": (Sphere(1.0, Material(E=200.0, nu=0.49, sigma_y=1.0)), FLAT, H_IN,
@@ -84,7 +84,7 @@ def test_out_of_range_parameter_warns_naming_it(name):
     assert np.all(np.isfinite(st.F))  # a warning, not a clip or an error
     with pytest.warns(CalibrationRangeWarning, match=pattern):
         law = ContactLaw(s1, s2, coeffs=CO)
-        law.force(h)
+        law.loading_force(h)
     with pytest.warns(CalibrationRangeWarning, match=pattern):
         contact_from_radius(s1, s2, st.a[st.a > 0], CO)
 
@@ -97,9 +97,9 @@ def test_in_range_call_raises_no_warning(name):
         st = contact(s1, s2, H_IN, CO)
         contact_from_radius(s1, s2, st.a, CO)
         law = ContactLaw(s1, s2, coeffs=CO)
-        law.force(H_IN)
+        law.loading_force(H_IN)
         law(H_IN)
-        law.force(np.concatenate([H_IN, [1e-14, 0.0, -1.0]]))  # exact fallback below the table
+        law.loading_force(np.concatenate([H_IN, [1e-14, 0.0, -1.0]]))  # exact fallback below the table
     assert law.range_issues == {}
     # at h_calibrated no sphere is beyond its own h_i/R_i = 0.3
     with warnings.catch_warnings():
@@ -125,15 +125,15 @@ def test_filter_error_escalates_and_ignore_silences():
 
 def test_warning_is_a_user_warning_attributed_to_the_caller():
     assert issubclass(CalibrationRangeWarning, UserWarning)
-    s1 = Sphere(1.0, Material(E=2.5, nu=0.3, sigma_y=1.0))
+    s1 = Sphere(1.0, Material(E=6.0, nu=0.3, sigma_y=1.0))
     for fun in (lambda: contact(s1, FLAT, 1e-3, CO), lambda: ContactLaw(s1, FLAT, coeffs=CO),
-                lambda: ContactLaw(Sphere(1.0, PP), FLAT, coeffs=CO).force(0.5)):
+                lambda: ContactLaw(Sphere(1.0, PP), FLAT, coeffs=CO).loading_force(0.5)):
         rec = _records(fun)
         assert rec and all(w.filename == __file__ for w in rec)
 
 
 def test_one_warning_per_cause_per_call_not_per_point():
-    s1 = Sphere(1.0, Material(E=2.5, nu=0.49, sigma_y=1.0))   # E/σ_Y and ν out
+    s1 = Sphere(1.0, Material(E=6.0, nu=0.49, sigma_y=1.0))   # E/σ_Y and ν out
     h = np.geomspace(1e-5, 1.0, 20000)                           # h/R and a/R out at many points
     rec = _records(lambda: contact(s1, FLAT, h, CO))
     msgs = sorted(str(w.message).split(" = ")[0] for w in rec)
@@ -143,13 +143,13 @@ def test_one_warning_per_cause_per_call_not_per_point():
 
 
 def test_table_warns_once_per_cause_not_per_evaluation():
-    s1 = Sphere(1.0, Material(E=2.5, nu=0.3, sigma_y=1.0))
+    s1 = Sphere(1.0, Material(E=6.0, nu=0.3, sigma_y=1.0))
     rec = _records(lambda: ContactLaw(s1, FLAT, coeffs=CO))
     assert [str(w.message).split(" = ")[0] for w in rec] == ["E/sigma_y"]
     law = ContactLaw(Sphere(1.0, PP), FLAT, coeffs=CO)
     rng = np.random.default_rng(1)
     h = np.exp(rng.uniform(math.log(1e-5), math.log(0.8), 10000))   # table and exact fallback
-    rec = _records(lambda: [law.force(h) for _ in range(50)] + [law(h)])
+    rec = _records(lambda: [law.loading_force(h) for _ in range(50)] + [law(h)])
     assert sorted(str(w.message).split(" = ")[0] for w in rec) == ["a/R", "h/R"]
     assert set(law.range_issues) == {"h_over_R", "a_over_R"}
     assert law.describe()["calibrated_range_warnings"] == list(law.range_issues.values())
@@ -162,9 +162,9 @@ def test_table_approach_threshold_matches_the_exact_check():
     h_a = law._pending["a_over_R"][1]          # approach where a/R first reaches 1
     a_exact = contact(s1, s2, np.array([0.99 * h_a, 1.01 * h_a]), CO).a
     assert a_exact[0] < 1.0 < a_exact[1]
-    rec = _records(lambda: law.force(np.array([0.1, 0.99 * h_a])))
+    rec = _records(lambda: law.loading_force(np.array([0.1, 0.99 * h_a])))
     assert [str(w.message).split(" = ")[0] for w in rec] == ["h/R"]
-    rec = _records(lambda: law.force(np.array([0.1, 1.01 * h_a])))
+    rec = _records(lambda: law.loading_force(np.array([0.1, 1.01 * h_a])))
     assert [str(w.message).split(" = ")[0] for w in rec] == ["a/R"]
 
 
@@ -202,7 +202,7 @@ def test_range_from_provenance_when_present_default_otherwise():
     with pytest.warns(CalibrationRangeWarning, match=r"E/sigma_y = 50 of sphere 1 .*\[100, 1000\]"):
         contact(s2, FLAT, h, co)
     with pytest.warns(CalibrationRangeWarning, match=r"h/R = 0\.2 .*h/R <= 0\.1"):
-        ContactLaw(s2, FLAT, coeffs=co).force(np.array([0.01, 0.2]))
+        ContactLaw(s2, FLAT, coeffs=co).loading_force(np.array([0.01, 0.2]))
 
 
 @pytest.mark.parametrize("key, bad", [("nu", [0.3]), ("h_over_R_max", "0.3"), ("E_over_sigma_y", [10, 1]),
@@ -251,5 +251,6 @@ def test_approach_check_is_per_sphere_like_the_calibration_scenes():
     assert max(st.h1[0] / 1.0, st.h2[0] / 4.0) == pytest.approx(0.3, rel=1e-6)  # table == exact
     assert t > 0.45                                       # body 2 takes part of the approach
     for h, warns in ((0.999 * t, False), (1.001 * t, True)):
-        rec = _records(lambda h=h: ContactLaw(s1, s2, h_max=1.0, coeffs=CO).force(np.array([0.01, h])))
+        law = ContactLaw(s1, s2, h_max=1.0, coeffs=CO)
+        rec = _records(lambda law=law, h=h: law.loading_force(np.array([0.01, h])))
         assert any("h/R" in str(w.message) for w in rec) == warns

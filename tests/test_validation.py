@@ -261,7 +261,7 @@ def test_report_from_a_fixture_database(tmp_path, capsys):
                      h=np.geomspace(2e-4, 0.3, 25), scale_F=1 / 1.07)]
     _fixture_database(db, val + _studies()[:3])
     out = tmp_path / "report"
-    rc = main(["--db", str(db), "--out", str(out), "--coefficients", "data/coefficients.json"])
+    rc = main(["--db", str(db), "--out", str(out), "--coefficients", "model/coefficients.json"])
     err = capsys.readouterr().err
     assert rc == 1 and "two-R2-Y2" in err and "flat-E300" not in err
     text = (out / "index.md").read_text()

@@ -1,7 +1,7 @@
 """``python -m spherecontact.validation``: the validation report from the reference database.
 
     python -m spherecontact.validation --db data/reference_v2.h5 \\
-        --coefficients data/coefficients.json --thresholds validation/thresholds.toml \\
+        --coefficients model/coefficients.json --thresholds validation/thresholds.toml \\
         --out reports/validation
 
 Writes ``OUT/index.md`` and its PNG charts. Exit status: 0 when every validation run is
@@ -25,7 +25,7 @@ def _parser() -> argparse.ArgumentParser:
                                 description=__doc__.splitlines()[0])
     p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
     p.add_argument("--coefficients", default=None,
-                   help="model coefficient file (default: the model's default, data/coefficients.json)")
+                   help="model coefficient file (default: the model's default, model/coefficients.json)")
     p.add_argument("--thresholds", default="validation/thresholds.toml", help="thresholds (TOML)")
     p.add_argument("--out", default="reports/validation", help="output directory")
     p.add_argument("--set", default="validation", help="database set to validate on")

@@ -114,7 +114,7 @@ def sensitivity_table(store: MdrStore) -> str:
 
 def model_cost_per_contact(comps: list[Comparison], coeffs, n: int = 1_000_000) -> dict:
     """Model cost per contact on the first run mdr applies to (best of three): the tabulated
-    ``ContactLaw`` built beforehand, F only (``law.force``, what a DEM step needs) and the whole
+    ``ContactLaw`` built beforehand, F only (``law.loading_force``, what a DEM step needs) and the whole
     state (``law(h)``: F, a, stiffness, h₁, h₂), and the exact solve (``contact``, per point of
     the run's curve)."""
     from ..model import ContactLaw
@@ -127,7 +127,7 @@ def model_cost_per_contact(comps: list[Comparison], coeffs, n: int = 1_000_000) 
     h = np.geomspace(1e-4, 0.3, n) * min(s1.radius, s2.radius if math.isfinite(s2.radius) else s1.radius)
     law = ContactLaw(s1, s2, coeffs=coeffs)
     out = {"case": pick.case.label, "n": n}
-    for key, fn in (("force", law.force), ("table", law)):
+    for key, fn in (("force", law.loading_force), ("table", law)):
         best = math.inf
         for _ in range(3):
             t0 = time.perf_counter()
@@ -150,7 +150,7 @@ def cost_rows(store: MdrStore, model_cost: dict) -> str:
             rows.append([f"LAMMPS {name}", f"{1e9 * t:.0f}", f"{1 / t:.3g}", what])
     if model_cost:
         how = f"numpy, {model_cost['n']:,} approaches of {model_cost['case']}, table built beforehand"
-        rows.append(["model, tabulated ContactLaw: F (law.force)", f"{1e9 * model_cost['force']:.0f}",
+        rows.append(["model, tabulated ContactLaw: F (law.loading_force)", f"{1e9 * model_cost['force']:.0f}",
                      f"{1 / model_cost['force']:.3g}", how])
         rows.append(["model, tabulated ContactLaw: F, a, dF/dh, h₁, h₂ (law(h))",
                      f"{1e9 * model_cost['table']:.0f}", f"{1 / model_cost['table']:.3g}", how])

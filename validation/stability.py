@@ -27,6 +27,7 @@ import numpy as np
 
 from ..model import Coefficients, Material, Sphere, contact
 from ..model.calibrated_range import CalibratedRange, CalibrationRangeWarning
+from ..model.material import E_OVER_SIGMA_Y_RANGE
 from .cases import Case, reference_radius, spheres
 from .charts import DPI, pyplot
 from .config import Thresholds
@@ -321,13 +322,14 @@ class Probe:
 def model_probes(coeffs: Coefficients | None, rng: CalibratedRange, h_over_R_max: float = 1.0):
     """The model on materials, pairs and approaches outside ``rng`` (and one inside, for contrast)."""
     E_lo, E_hi = rng.E_over_sigma_y
+    E_soft = max(E_lo / 4, E_OVER_SIGMA_Y_RANGE[0])  # below the calibrated range, still accepted
     flat = Sphere(math.inf, Material.rigid())
     pp = Material(E=200.0, nu=0.3, sigma_y=1.0)
     specs = [
         ("inside", f"E/σ_Y 200, ν 0.3, perfectly plastic, rigid flat (h/R > {rng.h_over_R_max:g} "
          "is outside)", Sphere(1.0, pp), flat),
-        ("soft elastic limit", f"E/σ_Y {E_lo / 4:g} (below {E_lo:g})",
-         Sphere(1.0, Material(E=E_lo / 4, nu=0.3, sigma_y=1.0)), flat),
+        ("soft elastic limit", f"E/σ_Y {E_soft:g} (below {E_lo:g}; the smallest accepted)",
+         Sphere(1.0, Material(E=E_soft, nu=0.3, sigma_y=1.0)), flat),
         ("very stiff", f"E/σ_Y {E_hi * 10:g} (above {E_hi:g})",
          Sphere(1.0, Material(E=E_hi * 10, nu=0.3, sigma_y=1.0)), flat),
         ("nearly incompressible", f"ν 0.49 (above {rng.nu[1]:g})",
