@@ -161,3 +161,26 @@ def test_fresh_lammps_run_reproduces_a_stored_curve(store):
     np.testing.assert_allclose(fresh.delta, d[:n], rtol=1e-8)
     np.testing.assert_allclose(fresh.F, stored["loading"]["F"][:n], rtol=1e-7)
     np.testing.assert_allclose(fresh.a, stored["loading"]["a"][:n], rtol=1e-7)
+
+
+def test_stored_mdr_is_hertz_below_first_yield(store):
+    """Zunker's mdr (Part I) is built on the method of dimensionality reduction, which is exact
+    for elastic spheres: below first yield it must be Hertz. No printed value of mdr could be
+    reached; this is the identity its published equations satisfy, checked on the LAMMPS output
+    (E* of the pair, R*; first yield at Jackson–Green's ω_c)."""
+    from spherecontact.validation import peers
+
+    checked = 0
+    for c in store.curves:
+        p = c.params
+        E_star = p["E"] / (1 - p["nu"] ** 2) / 2.0
+        R_star = 1.0 / (1.0 / p["R1"] + 1.0 / p["R2"])
+        wc = peers.jackson_green_critical(R_star, E_star, p["Y"], p["nu"])[0]
+        below = c.delta < wc
+        if below.sum() < 3:
+            continue
+        hz = peers.hertz(c.delta[below], E_star, R_star)
+        np.testing.assert_allclose(c.F[below], hz.F, rtol=2e-4)
+        np.testing.assert_allclose(c.a[below], hz.a, rtol=2e-4)
+        checked += 1
+    assert checked >= 3

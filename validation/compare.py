@@ -40,7 +40,7 @@ from .metrics import (
 from .peer_scenes import PEERS, NotApplicable, predict_peers
 
 __all__ = ["W_ACCEPT", "W_LARGE", "QUANTITIES", "MethodErrors", "Comparison", "compare_case",
-           "model_curve_time"]
+           "model_curve_time", "own_range_mask"]
 
 W_ACCEPT = "to 0.3"
 W_LARGE = "to 0.5"
@@ -59,9 +59,11 @@ class MethodErrors:
     a: np.ndarray | None = None
     h1: np.ndarray | None = None
     h2: np.ndarray | None = None
-    mask: np.ndarray | None = None     # points where the law is meant to hold (None: all)
+    mask: np.ndarray | None = None     # points where the law is evaluated (None: all)
+    in_range: np.ndarray | None = None  # points inside the law's stated range (None: all)
     errors: dict = field(default_factory=dict)   # quantity → error array
     windows: dict = field(default_factory=dict)  # window → quantity → Summary
+    own_range: dict = field(default_factory=dict)  # quantity → Summary in the law's own range
     levels: dict = field(default_factory=dict)   # level label → quantity → Summary
 
     def summary(self, window: str, quantity: str) -> Summary:
@@ -87,6 +89,7 @@ class Comparison:
     resolved: np.ndarray      # FE contact radius resolved by the mesh (a/R ≥ a_min_over_R)
     model: MethodErrors
     peers: dict               # name → MethodErrors
+    model_in_range: dict      # peer name → quantity → Summary of the model on the peer's range points
     model_time_s: float       # one evaluation of the model curve on the run's grid
     model_warnings: list
 
@@ -159,15 +162,30 @@ def compare_case(case: Case, coeffs: Coefficients | None, th: Thresholds, mdr=No
                          st.h2 if two else None)
     _errors_and_summaries(model, case, masks, labels, weights, resolved)
 
-    peer_results = {}
+    peer_results, model_in_range = {}, {}
+    # a law's own range: resolved points up to the acceptance window's end, from h = 0 (an
+    # elastic law's range ends before the window starts)
+    upto = resolved & (hR <= th.h_over_R_max * (1 + 1e-9))
     for name, pred in predict_peers(case, mdr).items():
         if isinstance(pred, NotApplicable):
             peer_results[name] = MethodErrors(name, False, pred.reason)
             continue
-        me = MethodErrors(name, True, pred.note, pred.F, pred.a, mask=pred.mask)
+        me = MethodErrors(name, True, pred.note, pred.F, pred.a, mask=pred.mask, in_range=pred.in_range)
         _errors_and_summaries(me, case, masks, labels, weights,
                               resolved if pred.mask is None else resolved & pred.mask)
+        own = own_range_mask(me, upto)
+        me.own_range = {q: summarise(e, own, weights) for q, e in me.errors.items()}
+        model_in_range[name] = {q: summarise(e, own, weights) for q, e in model.errors.items()}
         peer_results[name] = me
     assert tuple(peer_results) == PEERS
     return Comparison(case, classes(case), R, hR, lam, lev, labels, start, masks, resolved, model,
-                      peer_results, t_model, model_warnings)
+                      peer_results, model_in_range, t_model, model_warnings)
+
+
+def own_range_mask(m: MethodErrors, upto: np.ndarray) -> np.ndarray:
+    """Points of ``upto`` where the peer ``m`` is evaluated and inside its own stated range."""
+    own = upto.copy()
+    for extra in (m.mask, m.in_range):
+        if extra is not None:
+            own &= extra
+    return own

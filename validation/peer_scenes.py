@@ -43,26 +43,38 @@ from .mdr import NAME as MDR
 from .mdr import MdrStore, mdr_curve_at
 
 __all__ = ["PEERS", "PeerPrediction", "NotApplicable", "Equivalent", "equivalent", "predict_peers",
-           "power_law_fit", "CAVITY_RANGE"]
+           "power_law_fit", "CAVITY_RANGE", "RANGE_TEXT"]
 
 PEERS = ("Hertz", "Jackson–Green 2005", "Kogut–Etsion 2002", "Thornton 1997",
          "Johnson cavity", "Biwa–Storåkers 1995", MDR)
 
 #: range of Johnson's parameter E'a/(Yρ) where the cavity model is meant to hold
-CAVITY_RANGE = (3.0, 40.0)
+CAVITY_RANGE = peers.CAVITY_RANGE
+#: each law's stated range of validity, as the report prints it (:mod:`.peers` holds the bounds)
+RANGE_TEXT = {
+    "Hertz": f"elastic: h ≤ ω_c (ω/ω_c ≤ {peers.HERTZ_RANGE[1]:g})",
+    "Jackson–Green 2005": f"ω/ω_c ≤ {peers.JACKSON_GREEN_RANGE[1]:g}",
+    "Kogut–Etsion 2002": f"ω/ω_c ≤ {peers.KOGUT_ETSION_RANGE[1]:g}",
+    "Thornton 1997": f"δ/δ_y ≤ {peers.THORNTON_RANGE[1]:g} (not yet fully plastic)",
+    "Johnson cavity": f"{peers.CAVITY_RANGE[0]:g} ≤ E'a/(σ_Y ρ) ≤ {peers.CAVITY_RANGE[1]:g}",
+    "Biwa–Storåkers 1995": f"fully plastic: E'a/(σ_Y ρ) ≥ {peers.BIWA_STORAKERS_RANGE[0]:g}",
+    MDR: "its stored curve (claims large deformation)",
+}
 #: strains of the secant power law replacing a non-power-law flow curve (Biwa–Storåkers)
 POWER_FIT_STRAINS = (0.01, 0.1)
 
 
 class PeerPrediction(NamedTuple):
     """A peer law on a case. ``basis`` "h": F and a at the FE approaches; "a": F at the
-    FE contact radius (hardness laws; ``a`` is None). ``mask``: points where it holds."""
+    FE contact radius (hardness laws; ``a`` is None). ``mask``: points where it is evaluated
+    (None: all); ``in_range``: points inside the law's own stated range (None: all)."""
 
     F: np.ndarray
     a: np.ndarray | None
     basis: str = "h"
     mask: np.ndarray | None = None
     note: str = ""
+    in_range: np.ndarray | None = None
 
 
 class NotApplicable(NamedTuple):
@@ -121,7 +133,7 @@ def predict_peers(case: Case, mdr: MdrStore | None = None) -> dict:
         out[MDR] = NotApplicable(got)
     else:
         F, a, mask, note, _ = got
-        out[MDR] = PeerPrediction(F, a, mask=mask, note=note)
+        out[MDR] = PeerPrediction(F, a, mask=mask, note=note, in_range=mask)
     return out
 
 
@@ -135,9 +147,13 @@ def _predict_laws(case: Case) -> dict:
     pair_note = "E*, R*, total h" if two else ""
 
     hz = peers.hertz(eq.delta, eq.E_star, eq.R_star)
-    out["Hertz"] = PeerPrediction(hz.F, hz.a, note=pair_note or "elastic law")
-
     Y = eq.yielding
+    # elastic range: up to first yield of the body that yields first (Jackson–Green's ω_c)
+    hz_range = (None if Y is None else peers.in_range(
+        eq.delta / peers.jackson_green_critical(eq.R_star, eq.E_star, Y.sigma_y, Y.nu)[0],
+        peers.HERTZ_RANGE))
+    out["Hertz"] = PeerPrediction(hz.F, hz.a, note=pair_note or "elastic law", in_range=hz_range)
+
     if Y is None:
         reason = "no body can yield"
         for name in PEERS[1:]:
@@ -148,14 +164,20 @@ def _predict_laws(case: Case) -> dict:
                   if two and not eq.equal_materials else "")
     note = "; ".join(x for x in (pair_note, yield_note) if x)
     if epp:
+        w_jg = peers.jackson_green_critical(eq.R_star, eq.E_star, Y.sigma_y, Y.nu)[0]
+        w_ke = peers.kogut_etsion_critical(eq.R_star, eq.E_star, Y.sigma_y, Y.nu)[0]
         jg = peers.jackson_green(eq.delta, eq.R_star, eq.E_star, Y.sigma_y, Y.nu)
-        out["Jackson–Green 2005"] = PeerPrediction(jg.F, jg.a, note=note)
+        out["Jackson–Green 2005"] = PeerPrediction(
+            jg.F, jg.a, note=note, in_range=peers.in_range(eq.delta / w_jg, peers.JACKSON_GREEN_RANGE))
         ke = peers.kogut_etsion(eq.delta, eq.R_star, eq.E_star, Y.sigma_y, Y.nu)
-        out["Kogut–Etsion 2002"] = PeerPrediction(ke.F, ke.a, note=note)
+        out["Kogut–Etsion 2002"] = PeerPrediction(
+            ke.F, ke.a, note=note, in_range=peers.in_range(eq.delta / w_ke, peers.KOGUT_ETSION_RANGE))
         th = peers.thornton(eq.delta, eq.E_star, eq.R_star, _C(Y.nu) * Y.sigma_y)
+        # δ_y = (π p_y/(2E*))² R* with p_y = C σ_Y is Jackson–Green's ω_c
         out["Thornton 1997"] = PeerPrediction(
             th.F, th.a, note="; ".join(x for x in (note, "p_y = C(ν)σ_Y, peak Hertz pressure at "
-                                                    "first yield") if x))
+                                                    "first yield") if x),
+            in_range=peers.in_range(eq.delta / w_jg, peers.THORNTON_RANGE))
     else:
         reason = "fit/model for elastic–perfectly plastic spheres; this case hardens"
         for name in ("Jackson–Green 2005", "Kogut–Etsion 2002", "Thornton 1997"):
@@ -173,8 +195,9 @@ def _predict_laws(case: Case) -> dict:
         pm = Y.sigma_y * peers.johnson_cavity_hardness(a_fe / eq.rho, Y.E, Y.nu, Y.sigma_y)
         x = Y.E_prime * a_fe / (Y.sigma_y * eq.rho)
         lo, hi = CAVITY_RANGE
+        inside = peers.in_range(x, CAVITY_RANGE)
         out["Johnson cavity"] = PeerPrediction(
-            math.pi * a_fe**2 * pm, None, basis="a", mask=(x >= lo) & (x <= hi),
+            math.pi * a_fe**2 * pm, None, basis="a", mask=inside, in_range=inside,
             note=f"p_m at the FE contact radius, for {lo:g} ≤ E'a/(σ_Y ρ) ≤ {hi:g}"
                  + (", ρ = 2R*" if eq.equal_materials else ""))
 
@@ -187,6 +210,7 @@ def _predict_laws(case: Case) -> dict:
         fit = "" if is_perfectly_plastic(Y) else (f"secant power law σ_0 = {sigma_0:.3g}, "
                                                   f"n = {n:.3g}")
         eqn = "each body h/2 at ρ = 2R*" if eq.equal_materials else ""
-        out["Biwa–Storåkers 1995"] = PeerPrediction(bs.F, bs.a,
+        plastic = peers.in_range(Y.E_prime * bs.a / (Y.sigma_y * eq.rho), peers.BIWA_STORAKERS_RANGE)
+        out["Biwa–Storåkers 1995"] = PeerPrediction(bs.F, bs.a, in_range=plastic,
                                                     note="; ".join(x for x in (fit, eqn) if x))
     return out

@@ -6,16 +6,38 @@ follow each paper; E' = E/(1 − ν²) (or the combined 1/E* = Σ(1 − ν_i²)/
 R the sphere radius (or R* for two spheres). The model stage (DESIGN §5) is checked
 against these laws; nothing here depends on ``spherecontact.model``.
 
-Laws
-----
-* :func:`hertz` — Hertz (1882).
-* :func:`jackson_green` — Jackson & Green (2005), J. Tribol. 127:343–354.
-* :func:`kogut_etsion` — Kogut & Etsion (2002), J. Appl. Mech. 69:657–662.
-* :func:`thornton` — Thornton (1997), J. Appl. Mech. 64:383–386.
-* :func:`johnson_cavity_hardness` — Johnson (1970), J. Mech. Phys. Solids 18:115;
-  Johnson (1985), Contact Mechanics, §6.3.
-* :func:`biwa_storakers` — Biwa & Storåkers (1995), J. Mech. Phys. Solids 43:1303;
-  c² fit of Storåkers, Biwa & Larsson (1997), Int. J. Solids Struct. 34:3061.
+Every law carries its stated range of validity as data next to it (``*_RANGE``, in the
+law's own variable) and :func:`in_range` turns it into a mask; ``tests/test_peers.py``
+reproduces, for each law, a number printed in its source or (where no printed value
+could be reached) an identity its published equations must satisfy — each test says which.
+
+Laws, sources and ranges
+------------------------
+* :func:`hertz` — Hertz (1882); Johnson (1985), *Contact Mechanics*, §4.2 (a³ = 3PR/(4E*),
+  δ = a²/R). Range: elastic, ω ≤ ω_c (first yield; :data:`HERTZ_RANGE`).
+* :func:`jackson_green` — Jackson & Green (2005), J. Tribol. 127:343–354 (C(ν), ω_c, P_c and the
+  fits for P/P_c, A, H_G). The primary text was not reachable here: the equations agree
+  term by term with their transcription in an independent implementation of the paper's
+  fits; equation numbers are therefore not quoted. Range: 0 ≤ ω* ≤ 110 (:data:`JACKSON_GREEN_RANGE`).
+* :func:`kogut_etsion` — Kogut & Etsion (2002), J. Appl. Mech. 69:657–662 (piecewise fits of
+  P/P_c, A/A_c and p/Y for 1 ≤ ω* ≤ 6 and 6 ≤ ω* ≤ 110, ω_c after Chang, Etsion & Bogy 1987);
+  the dimensional form (1.37, 1.87 E k^… R^… ω^…) as printed by Kogut & Etsion (2003),
+  Tribol. Trans. 46:383. Range: 0 ≤ ω* ≤ 110, fully plastic beyond (:data:`KOGUT_ETSION_RANGE`).
+* :func:`thornton`, :func:`thornton_unloading` — Thornton (1997), J. Appl. Mech. 64:383–386:
+  Hertz truncated at the limiting contact pressure p_y on loading, Hertz with the
+  plastically flattened radius R_p on unloading, and the closed-form restitution coefficient
+  they give. Range: elastic–perfectly plastic, up to the onset of a fully plastic contact,
+  taken as Kogut–Etsion's ω* ≤ 110 (:data:`THORNTON_RANGE`).
+* :func:`johnson_cavity_hardness` — Johnson (1970), J. Mech. Phys. Solids 18:115; Johnson
+  (1985) §6.3 (expanding cavity model, cone of semi-angle tanβ ≈ a/R for a sphere).
+  Range: Johnson's elastic–plastic regime 3 ≤ E'a/(Yρ) ≤ 40 (:data:`CAVITY_RANGE`).
+* :func:`biwa_storakers` — Biwa & Storåkers (1995), J. Mech. Phys. Solids 43:1303; c² fit of
+  Storåkers, Biwa & Larsson (1997), Int. J. Solids Struct. 34:3061. Neither text was
+  reachable here; the coefficients are those this module has carried since it was
+  written, and the test checks the law's similarity identities and the exact linear case
+  c² = 1/2 of the similarity solution (Hill, Storåkers & Zdunek 1989). Range: a rigid–plastic
+  law, i.e. the fully plastic regime E'a/(σ_Y ρ) ≥ 40 (Johnson 1985 §6.3;
+  :data:`BIWA_STORAKERS_RANGE`).
 """
 
 from __future__ import annotations
@@ -27,6 +49,15 @@ import numpy as np
 
 __all__ = [
     "PeerCurve",
+    "HERTZ_RANGE",
+    "JACKSON_GREEN_RANGE",
+    "KOGUT_ETSION_RANGE",
+    "THORNTON_RANGE",
+    "CAVITY_RANGE",
+    "BIWA_STORAKERS_RANGE",
+    "in_range",
+    "thornton_unloading",
+    "thornton_restitution",
     "hertz",
     "jackson_green_critical",
     "jackson_green",
@@ -36,6 +67,29 @@ __all__ = [
     "johnson_cavity_hardness",
     "biwa_storakers",
 ]
+
+
+#: ω/ω_c where Hertz holds: elastic, up to first yield
+HERTZ_RANGE = (0.0, 1.0)
+#: ω* = ω/ω_c covered by Jackson & Green's (2005) fits
+JACKSON_GREEN_RANGE = (0.0, 110.0)
+#: ω* = ω/ω_c of Kogut & Etsion's (2002) fits (Hertz below 1; fully plastic beyond 110)
+KOGUT_ETSION_RANGE = (0.0, 110.0)
+#: δ/δ_c (δ_c the first-yield approach) where Thornton's (1997) truncated Hertz pressure is
+#: meant to hold: elastic–plastic, up to a fully plastic contact (Kogut–Etsion's 110)
+THORNTON_RANGE = (0.0, 110.0)
+#: E'a/(Yρ) of Johnson's (1985 §6.3) elastic–plastic regime (first yield to fully plastic)
+CAVITY_RANGE = (3.0, 40.0)
+#: E'a/(σ_Y ρ) of a fully plastic contact (Johnson 1985 §6.3), where a rigid–plastic law holds
+BIWA_STORAKERS_RANGE = (40.0, math.inf)
+
+
+def in_range(x, bounds: tuple[float, float]) -> np.ndarray:
+    """Mask of the values of a law's own variable ``x`` inside its stated range ``bounds``
+    (both ends included)."""
+    x = np.asarray(x, dtype=float)
+    lo, hi = bounds
+    return (x >= lo) & (x <= hi)
 
 
 class PeerCurve(NamedTuple):
@@ -60,7 +114,8 @@ def _positive(name: str, value: float) -> float:
 
 
 def hertz(h, E_star: float, R_star: float) -> PeerCurve:
-    """Hertz (1882): F = (4/3) E* √R* h^(3/2),  a² = R* h.
+    """Hertz (1882): F = (4/3) E* √R* h^(3/2),  a² = R* h  (Johnson 1985 §4.2: a³ = 3PR/(4E*),
+    δ = a²/R). Holds in the elastic range, h ≤ ω_c (:data:`HERTZ_RANGE`).
 
     Parameters
     ----------
@@ -93,6 +148,8 @@ def jackson_green_critical(R: float, E_prime: float, S_y: float, nu: float):
 
 def jackson_green(omega, R: float, E_prime: float, S_y: float, nu: float) -> PeerCurve:
     """Jackson & Green (2005) FE fit: elastic–perfectly plastic hemisphere on a rigid flat.
+
+    Holds for 0 ≤ ω* ≤ 110 (:data:`JACKSON_GREEN_RANGE`).
 
     With ω* = ω/ω_c (see :func:`jackson_green_critical`), e_y = S_y/E':
 
@@ -149,7 +206,9 @@ def kogut_etsion(omega, R: float, E_prime: float, Y: float, nu: float) -> PeerCu
     | 6 – 110    | 1.40 ω*^1.263     | 0.94 ω*^1.146     |
     | ≥ 110      | (3/K) ω*  (P = H A) | 2 ω*  (fully plastic, A = 2πRω) |
 
-    The published fits are not continuous at the switches (jumps of a few %).
+    The published fits are not continuous at the switches (jumps of a few %). Their stated
+    range is ω* ≤ 110 (:data:`KOGUT_ETSION_RANGE`); beyond it the contact is fully plastic
+    and the last row is Kogut & Etsion's fully plastic limit, not a fit.
     """
     w = np.maximum(_approach(omega), 0.0)
     omega_c, P_c, A_c, K = kogut_etsion_critical(R, E_prime, Y, nu)
@@ -175,6 +234,8 @@ def thornton(delta, E_star: float, R_star: float, p_y: float) -> PeerCurve:
     F = Hertz for δ ≤ δ_y,  F = F_y + π p_y R* (δ − δ_y) beyond;  a² = R* δ throughout.
     (dF/dδ is continuous at δ_y: 2E*a_y = π p_y R*.) Thornton sets p_y from the onset of
     yield; Johnson (1985, §6.2) gives a peak Hertz pressure of 1.60 Y at first yield (ν = 0.3).
+    Meant for elastic–perfectly plastic spheres up to a fully plastic contact
+    (δ/δ_y ≤ 110, :data:`THORNTON_RANGE`).
     """
     d = np.maximum(_approach(delta), 0.0)
     E_star, R_star, p_y = (_positive("E_star", E_star), _positive("R_star", R_star),
@@ -186,13 +247,46 @@ def thornton(delta, E_star: float, R_star: float, p_y: float) -> PeerCurve:
     return PeerCurve(F, np.sqrt(R_star * d))
 
 
+def thornton_unloading(delta, delta_max: float, E_star: float, R_star: float,
+                       p_y: float) -> tuple[np.ndarray, float]:
+    """Thornton (1997) unloading from the peak of :func:`thornton`: Hertz with the flattened radius.
+
+    R_p = 4E* a*³/(3F*),  δ_p = δ* − 3F*/(4E* a*),  F = (4/3) E* √R_p (δ − δ_p)^(3/2)
+    (F* and a* = √(R* δ*) the loading's peak; below yield R_p = R*, δ_p = 0).
+
+    Returns
+    -------
+    (F at ``delta`` on the unloading branch, δ_p)
+    """
+    d = _approach(delta)
+    E_star, R_star = _positive("E_star", E_star), _positive("R_star", R_star)
+    d_max = _positive("delta_max", delta_max)
+    F_max = float(thornton(d_max, E_star, R_star, p_y).F)
+    a_max = math.sqrt(R_star * d_max)
+    R_p = 4.0 * E_star * a_max**3 / (3.0 * F_max)
+    d_p = d_max - 3.0 * F_max / (4.0 * E_star * a_max)
+    return 4.0 / 3.0 * E_star * math.sqrt(R_p) * np.maximum(d - d_p, 0.0) ** 1.5, d_p
+
+
+def thornton_restitution(v_ratio) -> np.ndarray:
+    """Thornton's (1997) closed-form restitution coefficient of elastic–perfectly plastic spheres.
+
+    e = (6√3/5)^½ [1 − (1/6) x²]^½ [x/(x + 2√(6/5 − x²/5))]^¼,  x = V_y/V_i ≤ 1,
+    which tends to 1.185 x^¼ for V_i ≫ V_y (both as printed by Thornton).
+    """
+    x = np.asarray(v_ratio, dtype=float)
+    return (math.sqrt(6.0 * math.sqrt(3.0) / 5.0) * np.sqrt(1.0 - x * x / 6.0)
+            * (x / (x + 2.0 * np.sqrt(6.0 / 5.0 - x * x / 5.0))) ** 0.25)
+
+
 # --------------------------------------------------------------------- Johnson cavity model
 def johnson_cavity_hardness(a_over_R, E: float, nu: float, Y: float) -> np.ndarray:
     """Johnson's expanding-cavity model: mean pressure under a blunt indenter, p_m/Y.
 
     p_m/Y = (2/3) [1 + ln( (E tanβ/Y + 4(1 − 2ν)) / (6(1 − ν)) )],  tanβ ≈ a/R for a
-    sphere (Johnson 1970; Johnson 1985 §6.3). For ν = 1/2 this is the familiar
-    p_m/Y = (2/3)[1 + ln(E a/(3 Y R))]. Valid in the elastic–plastic range (Level II).
+    sphere (Johnson 1970; Johnson 1985 §6.3). For ν = 1/2 this is the form Johnson prints,
+    p_m/Y = (2/3)[1 + ln(E a/(3 Y R))]. Valid in Johnson's elastic–plastic range
+    3 ≤ E'a/(Yρ) ≤ 40 (:data:`CAVITY_RANGE`).
     """
     x = np.asarray(a_over_R, dtype=float)
     E, Y = _positive("E", E), _positive("Y", Y)
@@ -208,6 +302,9 @@ def biwa_storakers(h, R_star: float, sigma_0: float, n: float) -> PeerCurve:
     Flow curve σ = σ_0 ε^n (n = 1/m). Self-similar indentation:
     a² = 2 c² R* h with c² = 1.43 exp(−0.97 n)  (Storåkers, Biwa & Larsson 1997),
     p_m = 3.07 σ_0 (0.32 a/R*)^n                (Biwa & Storåkers 1995),  F = π a² p_m.
+
+    A rigid–plastic law: it holds in the fully plastic regime, E'a/(σ_Y ρ) ≥ 40
+    (:data:`BIWA_STORAKERS_RANGE`).
     """
     hh = np.maximum(_approach(h), 0.0)
     R_star, sigma_0 = _positive("R_star", R_star), _positive("sigma_0", sigma_0)

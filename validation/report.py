@@ -25,7 +25,7 @@ from .stability import (
     probes_section,
 )
 from .studies import mdr_points, reference, speed_accuracy, speed_accuracy_chart, speed_accuracy_table
-from .tables import class_matrix, class_tables, failures, level_table, pct, run_table
+from .tables import class_matrix, class_tables, failures, level_table, pct, range_tables, run_table
 from .unloading import unloading_failures, unloading_rows
 from .unloading_report import unloading_section
 
@@ -153,7 +153,15 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            "n/a: it applies to none (reasons in the class tables). Johnson's cavity model gives "
            "p_m only: its F column is the error of p_m at the FE contact radius, in its own range "
            "3 ≤ E'a/(σ_Y ρ) ≤ 40.", "",
-           class_matrix(comps), "", "### Per class: max (RMS) errors and where a law does not apply",
+           class_matrix(comps), "", "### Each peer in its own range",
+           "", "The whole-window figures above score a law also where it does not claim to hold (Hertz "
+           "far beyond first yield, a rigid–plastic law in the elastic–plastic range). Here each peer "
+           "is scored on the resolved FE points from h = 0 to the window end that lie inside its own "
+           "stated range (`validation/peers.py`, in the law's own variable: ω/ω_c, δ/δ_y, E'a/(σ_Y ρ)), "
+           "and the model on the same points; the model's whole-window figures are those of the "
+           "tables above and below. Johnson's cavity model: error of p_m (its whole window is "
+           "already its range).", "", range_tables(comps), "",
+           "### Per class: max (RMS) errors and where a law does not apply",
            "", class_tables(comps), "", "## The model against FE, per run", "",
            "Max (RMS) relative error in per cent; h₁/h split: max absolute error of the fraction "
            "in percentage points. `to 0.5`: runs that go beyond the acceptance window. FE scatter: "

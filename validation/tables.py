@@ -8,10 +8,10 @@ from .cases import CLASSES
 from .compare import MODEL, W_ACCEPT, W_LARGE, Comparison
 from .config import Thresholds
 from .metrics import EMPTY, LEVELS, Summary, pool, scatter
-from .peer_scenes import PEERS
+from .peer_scenes import PEERS, RANGE_TEXT
 
 __all__ = ["markdown_table", "pct", "cell", "run_table", "class_tables", "class_matrix",
-           "level_table", "failures", "Failure"]
+           "level_table", "failures", "Failure", "range_tables"]
 
 METHODS = (MODEL, *PEERS)
 
@@ -154,6 +154,34 @@ def class_tables(comps: list[Comparison]) -> str:
         out.append(f"**{cls}** ({names})\n\n" + markdown_table(
             ["method", "runs", f"F max (rms) % {W_ACCEPT}", f"a max (rms) % {W_ACCEPT}",
              f"F max % {W_LARGE}", f"a max % {W_LARGE}", "notes"], rows))
+    return "\n\n".join(out)
+
+
+def range_tables(comps: list[Comparison]) -> str:
+    """One table per class: each peer over the whole window beside the peer and the model on the
+    same points inside the peer's own stated range (resolved points from h = 0 to the window end)."""
+    out = []
+    for cls in CLASSES:
+        members = _class_members(comps, cls)
+        if not members:
+            continue
+        rows = []
+        for peer in PEERS:
+            have = [c for c in members if c.peers[peer].applies]
+            if not have:
+                rows.append([peer, RANGE_TEXT[peer], f"0/{len(members)}", "n/a", "—", "—", "—", "—", "—"])
+                continue
+            sF, _, _ = _pooled(members, peer, W_ACCEPT, "F")
+            own = {q: pool([c.peers[peer].own_range.get(q, EMPTY) for c in have]) for q in ("F", "a")}
+            mod = {q: pool([c.model_in_range[peer].get(q, EMPTY) for c in have]) for q in ("F", "a")}
+            runs_in = sum(1 for c in have if not c.peers[peer].own_range.get("F", EMPTY).empty)
+            rows.append([peer, RANGE_TEXT[peer], f"{len(have)}/{len(members)}", cell(sF),
+                         f"{own['F'].n} ({runs_in} runs)", cell(own["F"]), cell(mod["F"]), cell(own["a"]),
+                         cell(mod["a"])])
+        out.append(f"**{cls}**\n\n" + markdown_table(
+            ["peer", "its stated range", "runs", f"whole window: peer F max (rms) % {W_ACCEPT}",
+             "in range: points", "peer F max (rms) %", "model F max (rms) %", "peer a max (rms) %",
+             "model a max (rms) %"], rows))
     return "\n\n".join(out)
 
 

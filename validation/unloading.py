@@ -10,15 +10,24 @@ Every unloading branch of a validation run (campaign v2 unloads at h/R = 0.01, 0
   (``contact(s1, s2, h, h_max=…)``), so its loading error at h_max is part of it;
 * **Thornton (1997)** — Hertz from the FE's peak: residual radius R_p = 4E*a_max³/(3F_max),
   F = (4/3)E*√R_p (h − h_res)^(3/2), δ_e = 3F_max/(4E*a_max) (J. Appl. Mech. 64:383);
-* **Etsion, Kligerman & Kadin (2005)** — FE fit for an elastic–perfectly plastic sphere
-  unloaded from a rigid flat (Int. J. Solids Struct. 42:3716): with ω* = h_max/ω_c (Kogut–Etsion
-  critical interference, ``peers.kogut_etsion_critical``), h_res/h_max = 1.02[1 − (ω* + 5.9)^−0.54]
-  and F/F_max = ((h − h_res)/(h_max − h_res))^(1.5 ω*^−0.0331); fitted for 1 ≤ ω* ≤ 110: beyond
-  it ω* is held at 110 and the cycle flagged (the fit's h_res/h_max exceeds 1 from ω* ≈ 1900 on);
-  F_max from the FE. For two spheres E*, R* and the yield stress and ν of the softer body;
+* **Etsion, Kligerman & Kadin (2005)**, residual as quoted by Jackson, Chusoipin & Green
+  (2007, J. Tribol. 129:484) — FE fit for an elastic–plastic sphere unloaded from a rigid flat
+  (Int. J. Solids Struct. 42:3716; the primary text was not reachable here, the residual is
+  taken in the form its implementations quote): with ω* = h_max/ω_c (Kogut–Etsion critical
+  interference, ``peers.kogut_etsion_critical``),
+  h_res/h_max = 1.02[1 − ((ω* + 5.9)/6.9)^−0.54], which vanishes at first yield (ω* = 1), and
+  F/F_max = ((h − h_res)/(h_max − h_res))^(1.5 ω*^−0.0331) (Hertz's 3/2 at ω* = 1); fitted for
+  1 ≤ ω* ≤ 110 (:data:`EKK_RANGE`): beyond it ω* is held at 110 and the cycle flagged, below 1
+  the unloading is elastic (h_res = 0, exponent 3/2); F_max from the FE. For two spheres E*,
+  R* and the yield stress and ν of the softer body;
 * **LAMMPS mdr** — its stored unloading from its own loading to the FE run's last h_max
   (``data/peers/mdr.json``; the scenes mdr applies to, ``mdr.mdr_scene``): compared on the FE's
   branch from the same h_max, its loading error at the peak included like the model's.
+
+Each method's own range (``UnloadingRow.in_range``): the EKK fit 1 ≤ ω* ≤ 110; Thornton's
+elastic–perfectly plastic spheres past first yield up to a fully plastic contact (1 ≤ h_max/δ_y
+≤ 110, δ_y Jackson–Green's ω_c = Thornton's yield approach with p_y = C(ν)σ_Y); mdr wherever it
+is given; the model's law and the model everywhere.
 
 Errors: max |F − F_FE|/F_max,FE along the branch and |h_res − h_res,FE|/h_max. The restitution
 coefficient e = √(W_returned/W_in) of the first cycle (loaded from 0) is compared with the FE's
@@ -37,14 +46,21 @@ from ..cycles import UnloadingCurve, law_branch, run_cycles
 from ..fem.io import spheres_from_inputs
 from ..model import Coefficients, contact, cycle, default_coefficients
 from ..model.coefficients import UnloadingCoefficients
-from .cases import Case, scene_of
-from .peers import kogut_etsion_critical
+from .cases import Case, is_perfectly_plastic, scene_of
+from .peers import THORNTON_RANGE, jackson_green_critical, kogut_etsion_critical
 
-__all__ = ["UnloadingRow", "unloading_rows", "unloading_failures", "ekk_branch", "METHODS"]
+__all__ = ["UnloadingRow", "unloading_rows", "unloading_failures", "ekk_branch", "ekk_residual", "METHODS",
+           "EKK", "EKK_RANGE", "RANGE_TEXT"]
 
-METHODS = ("law", "model", "Thornton 1997", "Etsion et al. 2005", "LAMMPS mdr")
+#: the EKK residual is taken as Jackson, Chusoipin & Green quote it
+EKK = "EKK 2005 (JCG 2007 form)"
+METHODS = ("law", "model", "Thornton 1997", EKK, "LAMMPS mdr")
 #: ω* range of the Etsion–Kligerman–Kadin fit
 EKK_RANGE = (1.0, 110.0)
+#: each method's own range, as the report prints it
+RANGE_TEXT = {"law": "everywhere", "model": "everywhere",
+              "Thornton 1997": f"elastic–perfectly plastic, 1 ≤ h_max/δ_y ≤ {THORNTON_RANGE[1]:g}",
+              EKK: f"{EKK_RANGE[0]:g} ≤ ω* ≤ {EKK_RANGE[1]:g}", "LAMMPS mdr": "wherever given"}
 
 
 @dataclass
@@ -61,17 +77,25 @@ class UnloadingRow:
     e_fe: float              # restitution of the first cycle (nan for later cycles)
     e_model: float
     ekk_outside: bool        # ω* outside the EKK fit
+    in_range: dict           # method → the branch lies in the method's own range
     curve: UnloadingCurve
     branches: dict           # method → F/F_max at the FE's approaches (charts)
 
 
+def ekk_residual(omega_star) -> np.ndarray:
+    """h_res/h_max of Etsion, Kligerman & Kadin (2005) as quoted by Jackson, Chusoipin & Green:
+    1.02[1 − ((ω* + 5.9)/6.9)^−0.54] for ω* ≥ 1 (0 at first yield), 0 below (elastic)."""
+    ws = np.maximum(np.asarray(omega_star, dtype=float), 1.0)
+    return 1.02 * (1.0 - ((ws + 5.9) / 6.9) ** -0.54)
+
+
 def ekk_branch(h, h_max: float, F_max: float, omega_c: float) -> tuple[np.ndarray, float]:
     """Etsion, Kligerman & Kadin (2005): F on the branch from (h_max, F_max) and h_res (ω* held
-    in the fit's range 1 … 110)."""
-    ws = min(h_max / omega_c, EKK_RANGE[1])
-    h_res = h_max * 1.02 * (1.0 - (ws + 5.9) ** -0.54) if ws > 1.0 else 0.0
+    in the fit's range 1 … 110: the residual of :func:`ekk_residual`, the exponent 1.5 ω*^−0.0331)."""
+    ws = min(max(h_max / omega_c, EKK_RANGE[0]), EKK_RANGE[1])
+    h_res = h_max * float(ekk_residual(ws))
     xi = np.clip((np.asarray(h, dtype=float) - h_res) / (h_max - h_res), 0.0, 1.0)
-    return F_max * xi ** (1.5 * max(ws, 1.0) ** -0.0331), h_res
+    return F_max * xi ** (1.5 * ws ** -0.0331), h_res
 
 
 def _softer(s1, s2):
@@ -112,6 +136,8 @@ def _case_rows(case: Case, co: Coefficients, store=None) -> list[UnloadingRow]:
     R_star = 1.0 / sum(1.0 / s.radius for s in (s1, s2))
     Y, nu = _softer(s1, s2)
     omega_c = kogut_etsion_critical(R_star, E_star, Y, nu)[0] if math.isfinite(Y) else math.inf
+    delta_y = jackson_green_critical(R_star, E_star, Y, nu)[0] if math.isfinite(Y) else math.inf
+    epp = all(is_perfectly_plastic(s.material) for s in (s1, s2) if not s.is_rigid)
     F_fe_max = np.asarray(case.cycles["F_max"], dtype=float)
     cyc_model = cycle(s1, s2, np.array([c.h_max for c in curves]), co)
     mdr = _mdr_unloading(case, store)
@@ -138,17 +164,20 @@ def _case_rows(case: Case, co: Coefficients, store=None) -> list[UnloadingRow]:
         rows.append(UnloadingRow(
             run=case.label, key=case.key, cycle=k + 1, h_over_R=c.h_max / c.R, h_res_fe=c.h_res / c.h_max,
             F_err={"law": _branch_error(f_law, c), "model": _branch_error(f_model, c),
-                   "Thornton 1997": _branch_error(f_th, c), "Etsion et al. 2005": _branch_error(f_ekk, c),
+                   "Thornton 1997": _branch_error(f_th, c), EKK: _branch_error(f_ekk, c),
                    **F_err},
             h_res_err={"law": abs(h_res_law - c.h_res) / c.h_max,
                        "model": abs(float(cyc_model.h_res[k]) - c.h_res) / c.h_max,
                        "Thornton 1997": abs(h_res_th - c.h_res) / c.h_max,
-                       "Etsion et al. 2005": abs(h_res_ekk - c.h_res) / c.h_max, **h_err},
+                       EKK: abs(h_res_ekk - c.h_res) / c.h_max, **h_err},
             e_fe=math.sqrt(max(w_ret / w_in, 0.0)) if first and w_in > 0 else math.nan,
             e_model=float(cyc_model.restitution[k]) if first else math.nan,
             ekk_outside=not (EKK_RANGE[0] <= ws <= EKK_RANGE[1]),
+            in_range={"law": True, "model": True, EKK: EKK_RANGE[0] <= ws <= EKK_RANGE[1],
+                      "Thornton 1997": epp and 1.0 <= c.h_max / delta_y <= THORNTON_RANGE[1],
+                      "LAMMPS mdr": "LAMMPS mdr" in F_err},
             curve=c, branches={"law": f_law, "model": f_model, "Thornton 1997": f_th,
-                               "Etsion et al. 2005": f_ekk, **branches}))
+                               EKK: f_ekk, **branches}))
     return rows
 
 
