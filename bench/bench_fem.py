@@ -34,8 +34,8 @@ from spherecontact.fem.contact import RigidObstacle
 from spherecontact.fem.pair_speed import PENALTY as PAIR_SPEED_PENALTY
 from spherecontact.fem.solver import IndentationSolver, SolverOptions, phase_split
 from spherecontact.fem.twobody import TwoBodySolver
+from spherecontact.metrics import scatter
 from spherecontact.model import Material
-from spherecontact.validation.metrics import scatter
 
 #: the smooth configuration: surface band 0.03, penalty over the edges scaled with the approach
 SMOOTH = {"edge_band": 0.03, "penalty": 300.0, "segment_points": 8, "penalty_scale": "approach"}

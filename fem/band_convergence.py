@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import local_fit_at, scatter
 from ..model.material import Material
-from ..validation.metrics import local_fit_at, scatter
 from .io import run_indentation
 from .solver import SolverOptions
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..validation.metrics import interp_loglog
+from ..metrics import interp_loglog
 from .design import run_kwargs
 from .io import run_indentation
 

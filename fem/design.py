@@ -44,8 +44,8 @@ from scipy.stats import qmc
 
 from ..data import input_key
 from ..model.material import Material
+from ..model.run_inputs import material_from_description
 from .assembly import ELEMENTS
-from .io import material_from_description
 from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN, check_band_floor
 from .solver import SolverOptions
 

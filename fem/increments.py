@@ -32,8 +32,9 @@ from pathlib import Path
 import numpy as np
 
 from ..data import Database
-from ..validation.metrics import interp_loglog
-from .io import loading_mask, material_from_description, run_indentation
+from ..metrics import interp_loglog
+from ..model.run_inputs import material_from_description
+from .io import loading_mask, run_indentation
 from .solver import SolverOptions
 
 #: the re-run ends at the campaign's first unloading approach (units of the smaller radius)

@@ -69,7 +69,7 @@ import h5py
 import numpy as np
 
 from ..model.material import Material
-from ..model.sphere import Sphere
+from ..model.run_inputs import material_from_description
 from .assembly import ELEMENTS
 from .contact import RigidObstacle
 from .mesh import DENSITY_RANGE, check_band_floor, check_edge_band
@@ -87,7 +87,7 @@ __all__ = [
     "run_indentation",
     "write_run", "write_run_group", "share_mesh", "mesh_digest", "copy_run_group", "read_run",
     "run_from_group", "provenance",
-    "material_from_description", "loading_mask", "reference_mask", "START_TRANSIENT", "PROFILE_ROWS",
+    "loading_mask", "reference_mask", "START_TRANSIENT", "PROFILE_ROWS",
     "profile_increments",
 ]
 
@@ -810,37 +810,6 @@ def reference_mask(curves: dict, inputs: dict) -> np.ndarray:
     if not old_plastic_start(inputs, h1):
         return load
     return load & (h >= START_TRANSIENT * h1 * (1.0 - 1e-9))
-
-
-def material_from_description(m: dict) -> Material:
-    """Inverse of ``Material.describe()``: E = inf is rigid; missing plastic keys are elastic."""
-    E, nu = float(m["E"]), float(m.get("nu", 0.3))
-    if math.isinf(E):
-        return Material.rigid(nu)
-    if "eps_table" in m:
-        return Material.from_table(E, nu, m["eps_table"], m["sigma_table"])
-    return Material(E=E, nu=nu, sigma_y=float(m.get("sigma_y", math.inf)), K=float(m.get("K", 0.0)),
-                    n=float(m.get("n", 1.0)))
-
-
-def spheres_from_inputs(inputs: dict, scene: str) -> tuple[Sphere, Sphere]:
-    """The closed-form model's sphere pair of an FE run's ``inputs`` (``Run.inputs``).
-
-    Body 1 is the FE hemisphere (``radius``, ``material``); body 2 the partner of ``scene``:
-    ``"two_body"`` the second deformable sphere (``radius2``, ``material2``; the first's where
-    absent), ``"rigid_sphere"`` a rigid sphere of ``indenter_radius`` (``radius2`` where that
-    is infinite), anything else a rigid flat.
-    """
-    s1 = Sphere(float(inputs["radius"]), material_from_description(inputs["material"]))
-    if scene == "two_body":
-        m2 = inputs.get("material2", inputs["material"])
-        return s1, Sphere(float(inputs.get("radius2", s1.radius)), material_from_description(m2))
-    if scene == "rigid_sphere":
-        R2 = float(inputs.get("indenter_radius", math.inf))
-        if not math.isfinite(R2):
-            R2 = float(inputs["radius2"])
-        return s1, Sphere(R2, Material.rigid())
-    return s1, Sphere(math.inf, Material.rigid())
 
 
 @dataclass(frozen=True, eq=False)

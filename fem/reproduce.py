@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ..data import Database
-from ..validation.metrics import interp_loglog, scatter
+from ..metrics import interp_loglog, scatter
 from .contact import EDGE_FITS
 from .design import load_campaign
 from .io import loading_mask, run_indentation

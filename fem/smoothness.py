@@ -1,7 +1,7 @@
 """Cost against smoothness of the FE force: scatter of F(h) and a(h) per contact discretisation.
 
 The FE scatter of a curve is max |ln y − local quadratic in ln h| over 11 increments
-(``validation.metrics.scatter``), here over the points with a/R ≥ 0.01 up to h/R = 0.3,
+(``spherecontact.metrics.scatter``), here over the points with a/R ≥ 0.01 up to h/R = 0.3,
 and per band of a/R. A node closing at the contact edge adds a ring of nearly full
 plastic pressure, a step of about 2 Δs/a in F (Δs the surface node spacing), so the
 scatter falls with the surface element size at the edge. Compared here, on one body
@@ -32,8 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import scatter
 from ..model.material import Material
-from ..validation.metrics import scatter
 from .contact import RigidObstacle
 from .solver import IndentationSolver, SolverOptions
 

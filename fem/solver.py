@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.material import Material
+from ..peers import first_yield_approach as jg_first_yield
 from .assembly import Discretisation, positive_jacobian
 from .contact import EDGE_FITS, RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
 from .linsolve import METHODS as LINEAR_METHODS
@@ -479,10 +480,9 @@ CYCLE_KEYS = ("h_max", "F_max", "a_max", "h_res", "pole_radius", "work_in", "wor
 
 def first_yield_approach(materials, R_rel: float, E_star: float) -> float:
     """Approach of first yield by Hertz, ω_c = R*(π C σ_Y/(2E*))², C = 1.295 e^(0.736 ν)
-    (Jackson & Green 2005), the smallest over ``materials`` (the deformable bodies); inf when
-    they are elastic."""
-    return min((R_rel * (math.pi * 1.295 * math.exp(0.736 * m.nu) * m.sigma_y / (2.0 * E_star)) ** 2
-                for m in materials), default=math.inf)
+    (Jackson & Green 2005, :func:`spherecontact.peers.first_yield_approach`), the smallest over
+    ``materials`` (the deformable bodies); inf when they are elastic."""
+    return min((jg_first_yield(R_rel, E_star, m.sigma_y, m.nu) for m in materials), default=math.inf)
 
 
 def first_step(options: SolverOptions, length: float, scale: float, first_yield: float) -> float:

@@ -36,8 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import local_fit_at
 from ..model.material import Material
-from ..validation.metrics import local_fit_at
 from .contact import RigidObstacle
 from .solver import IndentationSolver, SolverOptions
 
@@ -113,7 +113,7 @@ def _at(run: dict, key: str, h: float) -> float:
 
 
 def _jg_omega_c(E_over_sy: float) -> float:
-    from ..validation.peers import jackson_green_critical
+    from ..peers import jackson_green_critical
 
     return jackson_green_critical(1.0, E_over_sy / (1 - NU**2), 1.0, NU)[0]
 
@@ -178,7 +178,7 @@ def _convergence_order(residuals: list[list[float]]) -> float:
 
 def evaluate(runs: dict, quick: bool) -> dict:
     """Figures and pass/fail of every check from the finished runs."""
-    from ..validation.peers import jackson_green
+    from ..peers import jackson_green
 
     out: dict = {}
     # ---- Hertz
@@ -319,7 +319,7 @@ def _plots(runs: dict, figures: dict, outdir: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..validation.peers import jackson_green
+    from ..peers import jackson_green
 
     names = []
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))

@@ -35,8 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import interp_loglog, scatter
 from ..model.material import Material
-from ..validation.metrics import interp_loglog, scatter
 from .io import run_indentation
 from .solver import LOAD, RELOAD, UNLOAD, IndentationSolver, SolverOptions
 
@@ -196,7 +196,7 @@ def _branch(c: dict, cyc: dict, i: int):
 
 
 def _loglog_interp(x, xp, yp):
-    """:func:`~..validation.metrics.interp_loglog` for points given in any order."""
+    """:func:`spherecontact.metrics.interp_loglog` for points given in any order."""
     order = np.argsort(xp)
     return interp_loglog(x, xp[order], yp[order])
 

@@ -11,7 +11,7 @@ from spherecontact.fem.contact import RigidObstacle
 from spherecontact.fem.mesh import EDGE_BAND_MIN, build_mesh
 from spherecontact.fem.segment_penalty import SegmentPenalty
 from spherecontact.fem.solver import SolverOptions
-from spherecontact.validation.metrics import interp_loglog
+from spherecontact.metrics import interp_loglog
 
 
 def _arc(n_edges: int = 6, radius: float = 1.0, span: float = 0.3):

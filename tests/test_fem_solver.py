@@ -8,7 +8,7 @@ import pytest
 from spherecontact.fem.contact import RigidObstacle
 from spherecontact.fem.solver import PHASES, IndentationSolver, SolverOptions
 from spherecontact.model import Material
-from spherecontact.validation.peers import jackson_green, jackson_green_critical
+from spherecontact.peers import jackson_green, jackson_green_critical
 
 E, NU = 200.0, 0.3
 EP = E / (1 - NU**2)

@@ -168,7 +168,7 @@ def test_stored_mdr_is_hertz_below_first_yield(store):
     for elastic spheres: below first yield it must be Hertz. No printed value of mdr could be
     reached; this is the identity its published equations satisfy, checked on the LAMMPS output
     (E* of the pair, R*; first yield at Jackson–Green's ω_c)."""
-    from spherecontact.validation import peers
+    from spherecontact import peers
 
     checked = 0
     for c in store.curves:

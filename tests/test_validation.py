@@ -5,19 +5,19 @@ import math
 import numpy as np
 import pytest
 
-from spherecontact.model import Material, Sphere, contact
-from spherecontact.validation import cases as vcases
-from spherecontact.validation import peers
-from spherecontact.validation.cases import Case, classes, reference_radius, spheres
-from spherecontact.validation.compare import W_ACCEPT, compare_case
-from spherecontact.validation.config import Thresholds, load_thresholds
-from spherecontact.validation.metrics import (
+from spherecontact import peers
+from spherecontact.metrics import (
     interp_loglog,
     pool,
     relative_error,
     summarise,
     trapezoid_weights,
 )
+from spherecontact.model import Material, Sphere, contact
+from spherecontact.validation import cases as vcases
+from spherecontact.validation.cases import Case, classes, reference_radius, spheres
+from spherecontact.validation.compare import W_ACCEPT, compare_case
+from spherecontact.validation.config import Thresholds, load_thresholds
 from spherecontact.validation.peer_scenes import NotApplicable, predict_peers
 from spherecontact.validation.tables import failures
 
@@ -297,21 +297,21 @@ def test_report_from_tiny_fe_runs(tmp_path):
 
 
 def test_scatter_measures_noise_not_curvature():
-    from spherecontact.validation.metrics import scatter
+    from spherecontact.metrics import scatter
 
     h = np.geomspace(1e-3, 0.3, 200)
     smooth = 2 * h**1.3 * (1 + h)
     assert scatter(h, smooth) < 1e-4
     wiggle = smooth * (1 + 0.01 * (-1) ** np.arange(h.size))
     assert 0.008 < scatter(h, wiggle) < 0.015  # ±1 % alternating noise (ends one-sided)
-    from spherecontact.validation.metrics import smooth_loglog
+    from spherecontact.metrics import smooth_loglog
 
     assert np.allclose(smooth_loglog(h, smooth), smooth, rtol=1e-4)
     assert np.max(np.abs(smooth_loglog(h, wiggle)[10:-10] / smooth[10:-10] - 1)) < 0.002
 
 
 def test_local_fit_reads_through_the_steps_that_the_point_value_sits_on():
-    from spherecontact.validation.metrics import local_fit_at
+    from spherecontact.metrics import local_fit_at
 
     h = np.geomspace(1e-3, 0.3, 200)
     smooth = 2 * h**1.3 * (1 + h)

@@ -23,8 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.io import loading_mask, reference_mask, spheres_from_inputs
+from ..fem.io import loading_mask, reference_mask
 from ..model import Material, Sphere
+from ..model.run_inputs import spheres_from_inputs
 
 __all__ = [
     "CLASSES",

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from ..fem.increments import read_reruns
+from ..metrics import interp_loglog
 from .compare import W_ACCEPT, Comparison
-from .metrics import interp_loglog
 
 __all__ = ["load_converged", "small_contact_rows", "small_contact_section"]
 

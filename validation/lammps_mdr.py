@@ -367,7 +367,7 @@ def _compare(ref: MdrCurve, other: MdrCurve, lo: float, factor: float = 1.0) -> 
     |ΔF| exceeds 1 % (None: nowhere); delta_res: the approach where ``other``'s unloading
     branch returns to F = 0.
     """
-    from .metrics import interp_loglog
+    from ..metrics import interp_loglog
 
     L = ref.loading
     dl = ref.delta[L]
