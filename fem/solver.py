@@ -1,6 +1,6 @@
 """Incremental Newton solver: one elastic–plastic hemisphere pressed on a rigid obstacle.
 
-Scene (DESIGN §4): the meridian section of a hemisphere of radius R (pole at
+Scene (docs/design.md §4): the meridian section of a hemisphere of radius R (pole at
 the origin, equatorial plane z = R); the equatorial plane is moved towards the
 obstacle by h (u_z = −h, free to slide radially), the axis has u_r = 0, the arc
 meets a rigid flat or rigid sphere in frictionless contact (``contact.py``).
@@ -610,7 +610,7 @@ class _RunState:
 
 
 class CycleLegs:
-    """Loading, unloading and elastic reloading legs of an incremental run (DESIGN §3b).
+    """Loading, unloading and elastic reloading legs of an incremental run (docs/design.md §3b).
 
     The solver provides ``options``, ``_length`` (its length scale), ``_step_scale``, ``_hist`` (lists ``h``,
     ``F``, ``a``, ``a_nodes``, ``work_external``, ``dissipation``, ``energy_elastic``,

@@ -1,4 +1,4 @@
-"""Incremental Newton solver: two deformable hemispheres pressed together (DESIGN §4).
+"""Incremental Newton solver: two deformable hemispheres pressed together (docs/design.md §4).
 
 Scene: body 1 (radius R₁) above, pole at the origin, equatorial plane z = R₁
 moved down by the total approach h; body 2 (radius R₂) below, pole at the

@@ -3,7 +3,7 @@
 Every function takes the approach (interference) as a float or array and returns
 arrays shaped like it; approaches ≤ 0 give zero force and contact radius. Symbols
 follow each paper; E' = E/(1 − ν²) (or the combined 1/E* = Σ(1 − ν_i²)/E_i),
-R the sphere radius (or R* for two spheres). The model stage (DESIGN §5) is checked
+R the sphere radius (or R* for two spheres). The model stage (docs/design.md §5) is checked
 against these laws; nothing here depends on ``spherecontact.model``.
 
 Every law carries its stated range of validity as data next to it (``*_RANGE``, in the

@@ -33,7 +33,7 @@ def test_hertz_force_against_contact_radius(elastic_run):
 
 
 def test_finite_sphere_carries_more_than_hertz(elastic_run):
-    """DESIGN §2: a hemisphere loaded through its equator is stiffer than the half-space."""
+    """docs/design.md §2: a hemisphere loaded through its equator is stiffer than the half-space."""
     c = elastic_run.curves
     ratio = np.interp(0.002, c["h"], c["F"] / (4 / 3 * EP * c["h"] ** 1.5))
     assert 1.01 < ratio < 1.035

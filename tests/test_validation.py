@@ -124,7 +124,7 @@ def test_peers_give_hertz_in_the_elastic_limit(scene, kw):
         assert np.allclose(pred[name].F, hz.F, rtol=1e-12), name
         assert np.allclose(pred[name].a, hz.a, rtol=1e-12), name
     # and the model tends to Hertz there too: its finite-size terms are linear in a/R
-    # (DESIGN §2), so the relative difference is at most of order a/R and vanishes with it
+    # (docs/design.md §2), so the relative difference is at most of order a/R and vanishes with it
     st = contact(s1, s2, h)
     x = hz.a / min(s1.radius, s2.radius)
     for q in ("F", "a"):

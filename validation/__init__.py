@@ -1,4 +1,4 @@
-"""Validation of the closed-form model and peer laws against FE runs (DESIGN §5).
+"""Validation of the closed-form model and peer laws against FE runs (docs/design.md §5).
 
 ``python -m spherecontact.validation`` (``make validate``) writes the report
 ``reports/validation/index.md``. Modules, in pipeline order:

@@ -19,7 +19,7 @@ carries the date, the Newton tolerance and the predictor it was measured with: a
 scatter moves with them (fem/README.md, "Smoothness of F").
 
 Writes ``smoothness.json`` and ``smoothness.png`` (scatter of F against wall time).
-``python -m spherecontact.fem.smoothness --out reports/fem`` (~85 min on one core).
+``python studies/fem_smoothness.py --out reports/fem`` (~85 min on one core).
 """
 
 from __future__ import annotations
@@ -32,10 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..metrics import scatter
-from ..model.material import Material
-from .contact import RigidObstacle
-from .solver import IndentationSolver, SolverOptions
+from spherecontact.fem.contact import RigidObstacle
+from spherecontact.fem.solver import IndentationSolver, SolverOptions
+from spherecontact.metrics import scatter
+from spherecontact.model.material import Material
 
 #: penalty contact integrated over the surface edges, scaled with the approach (P = 300)
 APPROACH = {"penalty": 300.0, "segment_points": 8, "penalty_scale": "approach"}
