@@ -897,14 +897,15 @@ class IndentationSolver(CycleLegs):
 
     def __init__(self, material: Material, radius: float = 1.0, obstacle: RigidObstacle | None = None,
                  density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None,
-                 edge_band: float = 0.0, band_floor: float | None = None):
+                 edge_band: float = 0.0, band_floor: float | None = None, *, options_checked: bool = False):
         if material.is_rigid:
             raise ValueError("the deformable body must not be rigid (E = inf)")
         self.material = material
         self.radius = float(radius)
         self.obstacle = obstacle or RigidObstacle()
         self.options = options or SolverOptions()
-        self.options.validate()
+        if not options_checked:  # io.run_checked passes options io.check_inputs validated
+            self.options.validate()
         t0 = time.perf_counter()
         self.hmesh = build_mesh(self.radius, density, linear=(element == "q4"), edge_band=edge_band,
                                 band_floor=band_floor)

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
+from fem_pair_speed import CASES, PENALTY, flat_kwargs, pair_kwargs, split_difference
 
-from spherecontact.fem.design import load_campaign
-from spherecontact.fem.pair_speed import CASES, PENALTY, flat_kwargs, pair_kwargs, split_difference
+from spherecontact.campaign.design import load_campaign
 
 
 def _curves(h, split):
@@ -72,7 +72,7 @@ def test_a_surface_band_given_applies_to_the_pair_and_its_flat_run_alike():
                                         (["--edge-band", "0.03", "--band-floor", "0.05"], "--band-floor"),
                                         (["--interleave", "11"], "--interleave")])
 def test_a_bad_band_is_named_before_any_run(args, word, capsys):
-    from spherecontact.fem.pair_speed import main
+    from fem_pair_speed import main
 
     with pytest.raises(SystemExit):
         main(args)

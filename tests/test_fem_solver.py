@@ -271,7 +271,7 @@ def test_smoothness_records_the_solver_settings_each_figure_was_measured_with():
     one), so every measurement carries them and its date."""
     import re
 
-    from spherecontact.fem.smoothness import measure
+    from fem_smoothness import measure
     r = measure(50.0, np.inf, 0.0, {"tol": 1e-6, "predictor": "secant"}, h_max=0.002)
     assert r["status"] == "converged" and r["newton_tol"] == 1e-6 and r["predictor"] == "secant"
     assert re.fullmatch(r"\d{4}-\d{2}-\d{2}", r["date_utc"])

