@@ -81,7 +81,7 @@ def test_a_bad_band_is_named_before_any_run(args, word, capsys):
 
 def test_interleaved_rounds_alternate_the_flat_and_the_pair(monkeypatch):
     """Each round runs body 1's flat and then the pair; the ratio is that of the summed walls."""
-    from spherecontact.fem import pair_speed
+    import fem_pair_speed as pair_speed
 
     calls, walls = [], iter([10.0, 30.0, 12.0, 30.0])
     monkeypatch.setattr(pair_speed, "_timed", lambda kw: (calls.append("options" in kw), next(walls)))
