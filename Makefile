@@ -12,7 +12,7 @@ export MKL_NUM_THREADS ?= 1
 .PHONY: test bench lint lint-imports demo clean
 .PHONY: fem campaign-design increments calibrate validate peers-mdr
 .PHONY: verify-fem verify-pair verify-pair-speed verify-pair-speed-band verify-pair-surface verify-pair-contacts
-.PHONY: verify-cycles verify-smoothness verify-band verify-increments verify-case verify-reproduce
+.PHONY: verify-cycles verify-smoothness verify-band verify-increments verify-reproduce
 .PHONY: verify-ceiling verify-validation-studies
 
 $(STAMP): pyproject.toml
@@ -77,9 +77,6 @@ verify-increments: $(STAMP)
 
 verify-band: $(STAMP)
 	$(PY) studies/fem_band_convergence.py --out reports/fem
-
-verify-case: $(STAMP)
-	$(PY) studies/fem_case_convergence.py --out reports/fem
 
 verify-reproduce: $(STAMP)
 	$(PY) studies/fem_reproduce.py --out reports/fem

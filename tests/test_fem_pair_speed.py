@@ -1,4 +1,4 @@
-"""fem.pair_speed: the split comparison and the runs it builds from a stored pair."""
+"""studies/fem_pair_speed.py: the split comparison and the runs it builds from a stored pair."""
 
 import numpy as np
 import pytest

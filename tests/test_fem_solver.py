@@ -1,4 +1,4 @@
-"""End-to-end FE runs, short and coarse enough for CI (the full figures: fem/verification.py)."""
+"""End-to-end FE runs, short and coarse enough for CI (the full figures: studies/fem_verification.py)."""
 
 import math
 
@@ -252,7 +252,8 @@ def test_smoothness_rerun_of_some_cases_keeps_the_others(tmp_path, monkeypatch):
     """``--only`` re-measures the chosen cases and keeps every earlier one in the file."""
     import json
 
-    from spherecontact.fem import smoothness
+    import fem_smoothness as smoothness
+
     earlier = [{"label": c[0], "wall_s": 1.0, "scatter_F": 0.01, "edge_band": c[3],
                 "indenter_radius": "inf", "E_over_sigma_y": c[1]} for c in smoothness.CASES]
     (tmp_path / "smoothness.json").write_text(json.dumps(earlier))
