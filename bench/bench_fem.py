@@ -21,7 +21,7 @@ time (149 s against 30 s) without any benchmark showing it. ``pair``: two plasti
 equal yield stress, E₂ = 3E₁ (E/σY 200 and 600), R₂ = 2R₁, two-pass penalty contact (P = 100),
 to h = 0.03 R₁, against body 1 alone on a rigid flat to the same approach (target: ≤ 3× its wall
 time); ``pair_approach``: the same pair with the penalty scaled with the approach (P = 3000;
-``fem.pair_speed``, whose ``make verify-pair-speed`` times the campaign's pairs to h/R 0.3).
+``studies/fem_pair_speed.py``, whose ``make verify-pair-speed`` times the campaign's pairs to h/R 0.3).
 The pairs' split per iteration has the same phases (constraints: the penalty tangent's assembly
 on its pattern) and the tangent predictor's (its triangular solves, its contact correction).
 """
@@ -31,11 +31,10 @@ from __future__ import annotations
 import math
 
 from spherecontact.fem.contact import RigidObstacle
-from spherecontact.fem.pair_speed import PENALTY as PAIR_SPEED_PENALTY
 from spherecontact.fem.solver import IndentationSolver, SolverOptions, phase_split
 from spherecontact.fem.twobody import TwoBodySolver
+from spherecontact.metrics import scatter
 from spherecontact.model import Material
-from spherecontact.validation.metrics import scatter
 
 #: the smooth configuration: surface band 0.03, penalty over the edges scaled with the approach
 SMOOTH = {"edge_band": 0.03, "penalty": 300.0, "segment_points": 8, "penalty_scale": "approach"}
@@ -82,6 +81,8 @@ PAIR_H = 0.03
 
 
 #: the ``pair_approach`` scene's penalty: k_N = P p_m/h, P as ``make verify-pair-speed`` runs it
+#: (``studies/fem_pair_speed.py``: the bodies sink in by about h/P, bounded)
+PAIR_SPEED_PENALTY = 3000.0
 PAIR_APPROACH = {"penalty": PAIR_SPEED_PENALTY, "penalty_scale": "approach"}
 
 

@@ -33,7 +33,7 @@ from spherecontact.model.coefficients import default_coefficients  # noqa: E402
 from spherecontact.model.fast import ContactLaw  # noqa: E402
 from spherecontact.model.range_check import range_check  # noqa: E402
 from spherecontact.model.unified import pair as unified_pair  # noqa: E402
-from spherecontact.validation.peers import jackson_green  # noqa: E402
+from spherecontact.peers import jackson_green  # noqa: E402
 
 # the steel–aluminium pair (yield ratio 4) lies outside the calibrated pair range (3): it is
 # here for its cost, a realistic engineering pair, not its accuracy

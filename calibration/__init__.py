@@ -1,6 +1,6 @@
-"""Calibration of H̄(Λ), c²(Λ) and the large-deformation terms from FE (DESIGN §2).
+"""Calibration of H̄(Λ), c²(Λ) and the large-deformation terms from FE (docs/design.md §2).
 
-``python -m spherecontact.calibration --db data/reference_v2.h5 --out model/coefficients.json
+``spherecontact calibrate --db data/reference_v2.h5 --out model/coefficients.json
 --report reports/calibration`` (``make calibrate``); ``calibration/README.md``.
 """
 

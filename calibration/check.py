@@ -1,6 +1,6 @@
 """Checks of a fitted coefficient set: F(h) continuous and monotone; model error per FE run.
 
-Monotone and continuous F(h) (DESIGN §3; the model inverts h(a)): along a dense grid
+Monotone and continuous F(h) (docs/design.md §3; the model inverts h(a)): along a dense grid
 of contact radii a (step ``STEP`` in ln a, 1e-6 R … 0.95 R) the model state must have
 
 * h(a) and F(a) strictly increasing (then F(h) is increasing and a(h) is unique),

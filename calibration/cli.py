@@ -1,4 +1,4 @@
-"""Command line of the calibration stage (thin layer over :func:`pipeline.calibrate`).
+"""``spherecontact calibrate``: the calibration stage's command (thin layer over :func:`pipeline.calibrate`).
 
 Exit codes: 0 done; 2 bad input (missing, unreadable or empty database); 3 no candidate
 form passed the monotonicity check (nothing written).
@@ -15,13 +15,11 @@ from .forms import CANDIDATES, FORMS
 from .workers import DEFAULT_WORKERS
 
 
-def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog="python -m spherecontact.calibration",
-        description="Fit H_bar(Lambda), c2(Lambda), the level boundaries, beta and the "
-                    "large-deformation terms to the FE calibration runs; choose the Level II "
-                    "form by cross-validation over five folds of held-out materials; write the "
-                    "coefficient file and the report.")
+def _add_arguments(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    p.description = ("Fit H_bar(Lambda), c2(Lambda), the level boundaries, beta and the "
+                     "large-deformation terms to the FE calibration runs; choose the Level II "
+                     "form by cross-validation over five folds of held-out materials; write the "
+                     "coefficient file and the report.")
     p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
     p.add_argument("--out", default="model/coefficients.json", help="coefficient file to write")
     p.add_argument("--report", default="reports/calibration", metavar="DIR",
@@ -39,16 +37,26 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"stopping tolerance of a fold fit, 1e-15-1e-2 (default {FOLD_TOL:g})")
     p.add_argument("--converged-fe", default=None, metavar="JSON",
                    help="replace each run's first loading by its re-run with finer increments "
-                        "(make verify-increments --set calibration, reports/fem/"
-                        "increments_calibration.json); default: the runs as stored")
+                        "(spherecontact campaign increments --set calibration); default: the runs as "
+                        "stored")
     p.add_argument("--converged-only", action="store_true",
                    help="leave out runs that stopped before h_max (default: fit their converged "
                         "increments)")
     return p
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+def build_parser() -> argparse.ArgumentParser:
+    """The ``calibrate`` options on a parser of their own (tests parse with it)."""
+    return _add_arguments(argparse.ArgumentParser(prog="spherecontact calibrate"))
+
+
+def register(subparsers) -> None:
+    """Add the ``calibrate`` command to the top-level parser."""
+    p = subparsers.add_parser("calibrate", help="calibrate the model from the reference database")
+    _add_arguments(p).set_defaults(func=calibrate_command)
+
+
+def calibrate_command(args: argparse.Namespace) -> int:
     forms = tuple(f for f in args.forms.split(",") if f)
     unknown = [f for f in forms if f not in FORMS]
     if unknown or not forms:

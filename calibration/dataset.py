@@ -1,4 +1,4 @@
-"""Calibration points from FE runs: ρ, σ_rep, Λ, H̄, c², a/R per increment (DESIGN §2).
+"""Calibration points from FE runs: ρ, σ_rep, Λ, H̄, c², a/R per increment (docs/design.md §2).
 
 A run is one deformable hemisphere (radius R) pressed by a rigid surface of radius
 R_i (``inf``: the flat that stands for an equal sphere by symmetry). The body sees the

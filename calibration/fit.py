@@ -22,7 +22,7 @@ built, and the residuals are those of the rounded set (what is written is what i
 measured).
 
 Constraints (penalty rows): H̄ must not decrease with Λ (``monotonicity_penalty``), so
-that the mean pressure rises with 1/ρ and the two-body κ solve has one root (DESIGN §3);
+that the mean pressure rises with 1/ρ and the two-body κ solve has one root (docs/design.md §3);
 the collapse limits must keep F and h rising with a up to a = R (``collapse_penalty``);
 the finite-size factors stay positive up to a = R (``finite_size_penalty``); the elastic sphere
 follows the FE's elastic hemisphere at h/R = 0.002–0.01 (``level_I_anchor``).
@@ -131,7 +131,7 @@ def monotonicity_penalty(co: Coefficients) -> np.ndarray:
 def monotonicity_margin(co: Coefficients) -> np.ndarray:
     """d ln H̄/d ln Λ over Level II for n in ``MONOTONE_N`` (must not be negative).
 
-    The two-body κ solve needs p_m to rise with 1/ρ (DESIGN §3), i.e. H̄(Λ) must not
+    The two-body κ solve needs p_m to rise with 1/ρ (docs/design.md §3), i.e. H̄(Λ) must not
     decrease: a Level II shape that overshoots H̄_III is penalised. Rows: the grid of
     ``MONOTONE_T`` × ``MONOTONE_N`` (n-major), then the same with the Λ dependence of the
     finite-size factor at each a/R of ``MONOTONE_X``.

@@ -32,9 +32,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.io import spheres_from_inputs
 from ..model import Sphere, contact
 from ..model.coefficients import Coefficients
+from ..model.run_inputs import spheres_from_inputs
 
 __all__ = ["COUPLINGS", "SIMILARITY", "SPLIT_TARGET", "FA_TARGET", "PairCurve", "InterfaceFit",
            "pair_errors", "target_ratio",

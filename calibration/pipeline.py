@@ -27,7 +27,6 @@ import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -37,14 +36,15 @@ from ..fem.increments import read_reruns, smaller_radius
 from ..model.coefficients import Coefficients
 from ..model.single import effective_exponent, hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
-from .crossval import DEFAULT_FOLDS, CVResult, FoldSolve, RegimeFold, fold_tasks, regime_tasks
+from .crossval import DEFAULT_FOLDS, CVResult, FoldSolve, fold_tasks, regime_tasks
 from .dataset import Dataset, build_dataset, quantities
 from .diagnostics import breakdown, noise_floor
 from .fit import ELASTIC_SPHERE, FitResult, fit, rms, round_sig
 from .forms import CANDIDATES, FORMS, Form
 from .interface import InterfaceFit, fit_interface, load_pairs, two_body_runs, with_interface
+from .result import Calibration, cv_score
 from .threads import single_threaded_blas
-from .unloading import H_RES_WEIGHT, TAIL, UnloadingFit, fit_unloading
+from .unloading import H_RES_WEIGHT, TAIL, fit_unloading
 from .workers import DEFAULT_WORKERS, Workers
 
 __all__ = ["Calibration", "calibrate_runs", "calibrate", "load_runs", "coefficient_file",
@@ -83,39 +83,6 @@ REFERENCES = {
                  "Thornton (1997) Hertz-from-the-peak unloading (stiffness 2E*a_max, exponent 3/2) "
                  "with finite-size stiffening and a peak-dependent exponent (model/unloading.py).",
 }
-
-
-def cv_score(cv: CVResult) -> float:
-    """E_cv = sqrt((RMS_F² + RMS_a²)/2) of the pooled held-out errors of F(h) and a(h)."""
-    p = cv.pooled()
-    return math.sqrt(0.5 * (p["F"]["rms"] ** 2 + p["a"]["rms"] ** 2))
-
-
-@dataclass
-class Calibration:
-    """Everything a calibration produced (inputs to the coefficient file and the report)."""
-
-    dataset: Dataset
-    fits: dict[str, FitResult]
-    cv: dict[str, CVResult]
-    chosen: str
-    checks: list[MonotoneCheck]
-    run_errors: list[RunError]
-    alternatives: dict[str, FitResult] = field(default_factory=dict)  # large-deformation options
-    alternative_checks: dict[str, bool] = field(default_factory=dict)
-    form_checks: dict[str, bool] = field(default_factory=dict)  # monotone check per form tried
-    source: dict = field(default_factory=dict)   # database path, hash, date, run keys, excluded
-    timings: dict = field(default_factory=dict)
-    noise: dict = field(default_factory=dict)      # scatter of the FE points (diagnostics.noise_floor)
-    breakdown: dict = field(default_factory=dict)  # residuals of the chosen form by band
-    regimes: list[RegimeFold] = field(default_factory=list)  # chosen form, one regime held out
-    interface: InterfaceFit | None = None  # two-body interface terms (``interface.py``)
-    unloading: UnloadingFit | None = None  # unloading law from the FE cycles (``unloading.py``)
-    folds: FoldSolve = field(default_factory=FoldSolve)  # how far the fold fits were solved
-
-    @property
-    def best(self) -> FitResult:
-        return self.fits[self.chosen]
 
 
 def _variant(form: Form, **changes) -> Form:

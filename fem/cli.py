@@ -13,6 +13,7 @@ import argparse
 import math
 import sys
 import textwrap
+from dataclasses import replace
 from pathlib import Path
 
 from ..model.cli_args import (
@@ -23,7 +24,7 @@ from ..model.cli_args import (
 )
 from .assembly import ELEMENTS
 from .contact import EDGE_FITS
-from .io import SCENES, check_inputs, run_indentation, write_run
+from .io import SCENES, check_inputs, run_checked, write_run
 from .linsolve import METHODS as LINEAR_METHODS
 from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN
 from .solver import PENALTY_SCALES, SEGMENT_SCHEMES, SolverOptions
@@ -85,7 +86,8 @@ def _summary(result, path: Path) -> str:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    """CLI handler of ``fem run``: validate, run, write, summarise; return the exit code."""
+    """CLI handler of ``fem run``: check the inputs once (:func:`.io.check_inputs`), run them
+    (:func:`.io.run_checked`), write, summarise; return the exit code."""
     material = material_from_args(args)
     options = options_from_args(args)
     out = output_path(args.out, RUN_SUFFIXES)
@@ -98,15 +100,10 @@ def run_command(args: argparse.Namespace) -> int:
                            material2=material2, scene=args.scene.replace("-", "_"),
                            unload_at=args.unload_at, edge_band=args.edge_band,
                            band_floor=args.band_floor)
-    print(f"scene: {checked['scene']} ({SCENES[checked['scene']]})", file=sys.stderr)
-    bar = _Progress(args.h_max, args.quiet)
+    print(f"scene: {checked.scene} ({SCENES[checked.scene]})", file=sys.stderr)
+    bar = _Progress(checked.h_max, args.quiet)
     try:
-        result = run_indentation(material, args.radius, args.h_max,
-                                 indenter_radius=args.indenter_radius, density=args.mesh_density,
-                                 element=args.element, options=options, progress=bar,
-                                 radius2=radius2, material2=material2,
-                                 scene=args.scene.replace("-", "_"), unload_at=args.unload_at,
-                                 edge_band=args.edge_band, band_floor=args.band_floor)
+        result = run_checked(replace(checked, progress=bar))
     finally:
         bar.close()
     extra = {"entry_point": "spherecontact fem run",

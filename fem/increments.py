@@ -1,4 +1,4 @@
-"""Increment convergence of stored reference curves where the contact is still small.
+"""The increment-converged first loading of a stored run, where the contact is still small.
 
 The loading increments are bounded by the strain per step, dh ≤ strain_increment · a
 (``SolverOptions``), which allows dh/h ≈ 0.01 c² R/a: about 0.6 at a/R = 0.02, ten increments a
@@ -9,31 +9,23 @@ the increments also bounded by the approach, dh ≤ r · h (``SolverOptions.rela
 compares F and a with the stored curve at its own approaches (loading increments after the
 first ones, ``io.reference_mask``; log–log interpolation of the new curve), per decade of h.
 
-``python -m spherecontact.fem.increments --db data/reference_v2.h5 --out reports/fem`` →
-``increments_validation.json``: every converged one-body run of the set (``--set``, default
-validation; ``--cases`` picks some), with the re-run curves, which the validation report reads
-(``validation/increments_report.py``); ~8 min for the 30 validation runs on two workers.
-``--h-end 0.3 --relative-step 0 --strain-increment 0.0025 --name …`` checks the whole loading
-window instead: the strain bound halved, no bound by the approach (each decade's mean of
-ln(stored/new) beside its largest, which a surface node closing at another increment sets).
+The validation set's re-runs are stored as data (``spherecontact campaign increments``, the
+database side in ``spherecontact.campaign.increments``) and read by the validation's
+small-contact section; ``studies/fem_increments_study.py`` runs other windows and bounds.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
-from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 
-from ..data import Database
-from ..validation.metrics import interp_loglog
-from .io import loading_mask, material_from_description, run_indentation
+from ..metrics import interp_loglog
+from ..model.run_inputs import material_from_description
+from .io import loading_mask, run_indentation
 from .solver import SolverOptions
 
 #: the re-run ends at the campaign's first unloading approach (units of the smaller radius)
@@ -50,7 +42,8 @@ def smaller_radius(inputs: dict) -> float:
 
 
 def read_reruns(path) -> tuple[dict, dict]:
-    """``(key → re-run case, header)`` of a file :func:`main` wrote; the header holds ``h_end``,
+    """``(key → re-run case, header)`` of a re-run file (``spherecontact campaign increments``,
+    :func:`spherecontact.campaign.increments.collect`); the header holds ``h_end``,
     ``date_utc``, ``db`` and ``note`` (what the calibration's ``--converged-fe`` and the validation's
     small-contact section read)."""
     d = json.loads(Path(path).read_text())
@@ -82,83 +75,24 @@ def by_decade(h_old, y_old, h_new, y_new, length: float) -> dict:
     return out
 
 
-def measure(db: Database, case: str, relative_step: float | None, h_end: float = H_END,
-            strain_increment: float | None = None) -> dict:
-    rec = next(r for r in db.records() if r.case == case)
-    run = db.run(rec.key)
+def measure_run(inputs: dict, run, relative_step: float | None, h_end: float = H_END,
+                strain_increment: float | None = None) -> dict:
+    """Re-run the first loading of the stored one-body ``run`` (a ``fem.io.Run`` of these
+    ``inputs``) with :func:`rerun` and compare: ln(stored/new) of F and a per decade of h
+    (:func:`by_decade`, a where a ≥ ``A_RESOLVED`` × the smaller radius), the increment counts,
+    the wall time and the new curve (8 significant digits)."""
     old = {"h": np.asarray(run.h), "F": np.asarray(run.F), "a": np.asarray(run.a)}
     keep = np.asarray(run.reference)  # loading increments without a first step's transient
-    L = smaller_radius(rec.inputs)
+    L = smaller_radius(inputs)
     t = time.perf_counter()
-    new = rerun(rec.inputs, relative_step, h_end, strain_increment)
+    new = rerun(inputs, relative_step, h_end, strain_increment)
     wall = time.perf_counter() - t
     keep &= (old["h"] >= new.h[0]) & (old["h"] <= new.h[-1])
     ka = keep & (old["a"] >= A_RESOLVED * L)
-    return {"case": case, "key": rec.key, "relative_step": relative_step,
+    return {"relative_step": relative_step,
             "strain_increment": strain_increment, "wall_s": round(wall, 1),
             "stored_increments": int(np.count_nonzero(old["h"][loading_mask(run.curves)] <= h_end * L)),
             "new_increments": int(new.h.size),
             "F": by_decade(old["h"][keep], old["F"][keep], new.h, new.F, L),
             "a": by_decade(old["h"][ka], old["a"][ka], new.h, new.a, L) if ka.any() else None,
             "curve": {q: [float(f"{v:.8g}") for v in getattr(new, q)] for q in ("h", "F", "a")}}
-
-
-def _measure_in_worker(args: tuple) -> dict:
-    db_path, case, *steps = args
-    return measure(Database(db_path), case, *steps)
-
-
-def one_body_cases(db: Database, set_name: str) -> list[str]:
-    """The cases of ``set_name`` with one deformable body (rigid flat or sphere), sorted."""
-    return sorted(r.case for r in db.records(set=set_name)
-                  if r.inputs.get("scene") in ("rigid_flat", "rigid_sphere") and r.status == "converged")
-
-
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--db", default="data/reference_v2.h5")
-    ap.add_argument("--out", default="reports/fem")
-    ap.add_argument("--set", default="validation", help="every converged one-body case of this set")
-    ap.add_argument("--cases", nargs="*", default=None, help="these cases instead of --set")
-    ap.add_argument("--relative-step", type=float, default=RELATIVE_STEP,
-                    help=f"increments dh <= this * h (default {RELATIVE_STEP:g}; 0: no such bound)")
-    ap.add_argument("--h-end", type=float, default=H_END,
-                    help=f"approach the re-runs end at, in units of the smaller radius (default {H_END:g})")
-    ap.add_argument("--strain-increment", type=float, default=None,
-                    help="increments dh <= this * a (default: the solver's)")
-    ap.add_argument("--workers", type=int, default=2, help="processes (one case each at a time)")
-    ap.add_argument("--name", default="increments_validation.json", help="file written in --out")
-    args = ap.parse_args(argv)
-    if not 0.0 <= args.relative_step <= 10.0:
-        ap.error(f"--relative-step must lie in [0, 10] (0: no bound), got {args.relative_step:g}")
-    if not 0.0 < args.h_end <= 0.5:
-        ap.error(f"--h-end must lie in (0, 0.5] (units of the smaller radius), got {args.h_end:g}")
-    relative_step = args.relative_step or None
-    db = Database(args.db)
-    cases = args.cases if args.cases else one_body_cases(db, args.set)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    results = {"date_utc": datetime.now(UTC).strftime("%Y-%m-%d"), "db": args.db, "h_end": args.h_end,
-               "note": "ln(stored/new) per decade of h over the smaller radius, largest |.| (and the "
-                       "decade's mean under 'mean'), at the stored loading increments after the first "
-                       "ones (a: where a >= 0.01 of the smaller radius); new: increments dh <= "
-                       "relative_step h (null: no such bound) and dh <= strain_increment a (null: "
-                       "the solver's)", "cases": []}
-    work = [(args.db, c, relative_step, args.h_end, args.strain_increment) for c in cases]
-    with ProcessPoolExecutor(max(1, args.workers), mp_context=multiprocessing.get_context("fork")) as pool:
-        done = pool.map(_measure_in_worker, work)
-        for case, r in zip(cases, done, strict=True):
-            results["cases"].append(r)
-            _print(case, r)
-            (out / args.name).write_text(json.dumps(results, separators=(",", ":")) + "\n")
-    return 0
-
-
-def _print(case: str, r: dict) -> None:
-    a = f"{100 * r['a']['largest']:+.2f} %" if r["a"] else "—"
-    print(f"{case}: F {100 * r['F']['largest']:+.2f} %, a {a} "
-          f"({r['stored_increments']} → {r['new_increments']} increments, {r['wall_s']:.0f} s)", flush=True)
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -69,7 +69,7 @@ import h5py
 import numpy as np
 
 from ..model.material import Material
-from ..model.sphere import Sphere
+from ..model.run_inputs import material_from_description
 from .assembly import ELEMENTS
 from .contact import RigidObstacle
 from .mesh import DENSITY_RANGE, check_band_floor, check_edge_band
@@ -83,11 +83,11 @@ from .solver import (
 from .twobody import TwoBodySolver
 
 __all__ = [
-    "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "SCENES", "Run", "check_inputs", "choose_scene",
-    "run_indentation",
+    "SCHEMA", "SCHEMA_VERSION", "GROUP", "CURVES", "SCENES", "Run", "CheckedInputs", "check_inputs",
+    "choose_scene", "run_indentation", "run_checked",
     "write_run", "write_run_group", "share_mesh", "mesh_digest", "copy_run_group", "read_run",
     "run_from_group", "provenance",
-    "material_from_description", "loading_mask", "reference_mask", "START_TRANSIENT", "PROFILE_ROWS",
+    "loading_mask", "reference_mask", "START_TRANSIENT", "PROFILE_ROWS",
     "profile_increments",
 ]
 
@@ -233,10 +233,33 @@ def choose_scene(material, radius, material2=None, radius2=None,
     return "two_body"
 
 
+@dataclass(frozen=True)
+class CheckedInputs:
+    """The inputs of one run as :func:`check_inputs` checked and normalised them: the scene
+    chosen, radius2 and indenter_radius resolved, ``options`` validated. :func:`run_checked` runs
+    them without checking again (the command line checks once, at the boundary)."""
+
+    material: Material
+    radius: float
+    h_max: float
+    indenter_radius: float
+    density: float
+    element: str
+    edge_band: float
+    band_floor: float | None
+    options: SolverOptions
+    progress: Callable[[float], object] | None
+    material2: Material | None
+    radius2: float
+    scene: str
+    unload_at: np.ndarray | None
+
+
 def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
                  element="q8r", options=None, progress=None, radius2=None, material2=None,
-                 scene="auto", unload_at=None, edge_band=0.0, band_floor=None) -> dict:
-    """Validate every input of :func:`run_indentation`; return them normalised.
+                 scene="auto", unload_at=None, edge_band=0.0, band_floor=None) -> CheckedInputs:
+    """Validate every input of :func:`run_indentation` once; return them normalised
+    (:class:`CheckedInputs`, which :func:`run_checked` runs without checking again).
 
     Raises ValueError naming the parameter and its allowed range.
     """
@@ -283,11 +306,10 @@ def check_inputs(material, radius, h_max, indenter_radius=math.inf, density=1.0,
     if progress is not None and not callable(progress):
         raise ValueError("progress must be a callable progress(h) or None")
     unload = check_unload_at(unload_at, h)
-    return {"material": material, "radius": R, "h_max": h, "indenter_radius": R_ind,
-            "density": d, "element": element, "edge_band": band, "band_floor": floor,
-            "options": options, "progress": progress,
-            "material2": material2, "radius2": R2, "scene": chosen,
-            "unload_at": unload if unload.size else None}
+    return CheckedInputs(material=material, radius=R, h_max=h, indenter_radius=R_ind, density=d,
+                         element=element, edge_band=band, band_floor=floor, options=options,
+                         progress=progress, material2=material2, radius2=R2, scene=chosen,
+                         unload_at=unload if unload.size else None)
 
 
 def _with_pair_curves(result: RunResult, scene: str) -> RunResult:
@@ -346,18 +368,24 @@ def run_indentation(material: Material, radius: float, h_max: float,
     ``band_floor``: the band's smallest element size (None: ``mesh.EDGE_BAND_MIN``).
     Returns the solver's ``RunResult``.
     """
-    a = check_inputs(material, radius, h_max, indenter_radius, density, element, options,
-                     progress, radius2, material2, scene, unload_at, edge_band, band_floor)
-    unload_at = a["unload_at"]
-    chosen = a["scene"]
+    return run_checked(check_inputs(material, radius, h_max, indenter_radius, density, element,
+                                    options, progress, radius2, material2, scene, unload_at,
+                                    edge_band, band_floor), schedule)
+
+
+def run_checked(a: CheckedInputs, schedule=None) -> RunResult:
+    """Run the inputs :func:`check_inputs` returned, without checking them again
+    (``schedule`` as in :func:`run_indentation`)."""
+    unload_at = a.unload_at
+    chosen = a.scene
     if chosen == "two_body":
         if schedule is not None:
             raise ValueError("schedule: prescribed increments exist for the one-body scenes only")
-        solver = TwoBodySolver(a["material"], a["radius"], a["material2"], a["radius2"],
-                               density=a["density"], element=a["element"], options=a["options"],
-                               edge_band=a["edge_band"], band_floor=a["band_floor"])
-        return solver.run(a["h_max"], progress=a["progress"], unload_at=unload_at)
-    h_run, progress = a["h_max"], a["progress"]
+        solver = TwoBodySolver(a.material, a.radius, a.material2, a.radius2,
+                               density=a.density, element=a.element, options=a.options,
+                               edge_band=a.edge_band, band_floor=a.band_floor, options_checked=True)
+        return solver.run(a.h_max, progress=a.progress, unload_at=unload_at)
+    h_run, progress = a.h_max, a.progress
     if chosen == "equal_pair_symmetry":
         h_run = 0.5 * h_run
         if progress is not None:
@@ -365,18 +393,18 @@ def run_indentation(material: Material, radius: float, h_max: float,
 
             def progress(h):
                 return outer(2.0 * h)
-    solver = IndentationSolver(a["material"], a["radius"],
-                               obstacle=RigidObstacle(a["indenter_radius"]),
-                               density=a["density"], element=a["element"], options=a["options"],
-                               edge_band=a["edge_band"], band_floor=a["band_floor"])
+    solver = IndentationSolver(a.material, a.radius,
+                               obstacle=RigidObstacle(a.indenter_radius),
+                               density=a.density, element=a.element, options=a.options,
+                               edge_band=a.edge_band, band_floor=a.band_floor, options_checked=True)
     if schedule is not None and chosen == "equal_pair_symmetry":
         schedule = 0.5 * np.asarray(schedule, dtype=float)
     if unload_at is not None and chosen == "equal_pair_symmetry":
         unload_at = 0.5 * unload_at
     result = _with_pair_curves(solver.run(h_run, progress=progress, schedule=schedule,
                                           unload_at=unload_at), chosen)
-    if a["material2"] is not None and a["material2"].is_rigid:
-        result.inputs.update(material2=a["material2"].describe(), radius2=a["radius2"])
+    if a.material2 is not None and a.material2.is_rigid:
+        result.inputs.update(material2=a.material2.describe(), radius2=a.radius2)
     return result
 
 
@@ -810,37 +838,6 @@ def reference_mask(curves: dict, inputs: dict) -> np.ndarray:
     if not old_plastic_start(inputs, h1):
         return load
     return load & (h >= START_TRANSIENT * h1 * (1.0 - 1e-9))
-
-
-def material_from_description(m: dict) -> Material:
-    """Inverse of ``Material.describe()``: E = inf is rigid; missing plastic keys are elastic."""
-    E, nu = float(m["E"]), float(m.get("nu", 0.3))
-    if math.isinf(E):
-        return Material.rigid(nu)
-    if "eps_table" in m:
-        return Material.from_table(E, nu, m["eps_table"], m["sigma_table"])
-    return Material(E=E, nu=nu, sigma_y=float(m.get("sigma_y", math.inf)), K=float(m.get("K", 0.0)),
-                    n=float(m.get("n", 1.0)))
-
-
-def spheres_from_inputs(inputs: dict, scene: str) -> tuple[Sphere, Sphere]:
-    """The closed-form model's sphere pair of an FE run's ``inputs`` (``Run.inputs``).
-
-    Body 1 is the FE hemisphere (``radius``, ``material``); body 2 the partner of ``scene``:
-    ``"two_body"`` the second deformable sphere (``radius2``, ``material2``; the first's where
-    absent), ``"rigid_sphere"`` a rigid sphere of ``indenter_radius`` (``radius2`` where that
-    is infinite), anything else a rigid flat.
-    """
-    s1 = Sphere(float(inputs["radius"]), material_from_description(inputs["material"]))
-    if scene == "two_body":
-        m2 = inputs.get("material2", inputs["material"])
-        return s1, Sphere(float(inputs.get("radius2", s1.radius)), material_from_description(m2))
-    if scene == "rigid_sphere":
-        R2 = float(inputs.get("indenter_radius", math.inf))
-        if not math.isfinite(R2):
-            R2 = float(inputs["radius2"])
-        return s1, Sphere(R2, Material.rigid())
-    return s1, Sphere(math.inf, Material.rigid())
 
 
 @dataclass(frozen=True, eq=False)

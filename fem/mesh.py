@@ -1,4 +1,4 @@
-"""Graded quadratic mesh of one hemisphere's meridian section (DESIGN §4).
+"""Graded quadratic mesh of one hemisphere's meridian section (docs/design.md §4).
 
 The section is the quarter disk r ≥ 0, z ≤ R, r² + (z − R)² ≤ R²: the contact
 pole at the origin, the centre at (0, R), the equatorial plane z = R. gmsh

@@ -1,6 +1,6 @@
 """Incremental Newton solver: one elastic–plastic hemisphere pressed on a rigid obstacle.
 
-Scene (DESIGN §4): the meridian section of a hemisphere of radius R (pole at
+Scene (docs/design.md §4): the meridian section of a hemisphere of radius R (pole at
 the origin, equatorial plane z = R); the equatorial plane is moved towards the
 obstacle by h (u_z = −h, free to slide radially), the axis has u_r = 0, the arc
 meets a rigid flat or rigid sphere in frictionless contact (``contact.py``).
@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model.material import Material
+from ..peers import first_yield_approach as jg_first_yield
 from .assembly import Discretisation, positive_jacobian
 from .contact import EDGE_FITS, RigidObstacle, contact_edge, smooth_contact_radius, surface_areas
 from .linsolve import METHODS as LINEAR_METHODS
@@ -479,10 +480,9 @@ CYCLE_KEYS = ("h_max", "F_max", "a_max", "h_res", "pole_radius", "work_in", "wor
 
 def first_yield_approach(materials, R_rel: float, E_star: float) -> float:
     """Approach of first yield by Hertz, ω_c = R*(π C σ_Y/(2E*))², C = 1.295 e^(0.736 ν)
-    (Jackson & Green 2005), the smallest over ``materials`` (the deformable bodies); inf when
-    they are elastic."""
-    return min((R_rel * (math.pi * 1.295 * math.exp(0.736 * m.nu) * m.sigma_y / (2.0 * E_star)) ** 2
-                for m in materials), default=math.inf)
+    (Jackson & Green 2005, :func:`spherecontact.peers.first_yield_approach`), the smallest over
+    ``materials`` (the deformable bodies); inf when they are elastic."""
+    return min((jg_first_yield(R_rel, E_star, m.sigma_y, m.nu) for m in materials), default=math.inf)
 
 
 def first_step(options: SolverOptions, length: float, scale: float, first_yield: float) -> float:
@@ -610,7 +610,7 @@ class _RunState:
 
 
 class CycleLegs:
-    """Loading, unloading and elastic reloading legs of an incremental run (DESIGN §3b).
+    """Loading, unloading and elastic reloading legs of an incremental run (docs/design.md §3b).
 
     The solver provides ``options``, ``_length`` (its length scale), ``_step_scale``, ``_hist`` (lists ``h``,
     ``F``, ``a``, ``a_nodes``, ``work_external``, ``dissipation``, ``energy_elastic``,
@@ -897,14 +897,15 @@ class IndentationSolver(CycleLegs):
 
     def __init__(self, material: Material, radius: float = 1.0, obstacle: RigidObstacle | None = None,
                  density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None,
-                 edge_band: float = 0.0, band_floor: float | None = None):
+                 edge_band: float = 0.0, band_floor: float | None = None, *, options_checked: bool = False):
         if material.is_rigid:
             raise ValueError("the deformable body must not be rigid (E = inf)")
         self.material = material
         self.radius = float(radius)
         self.obstacle = obstacle or RigidObstacle()
         self.options = options or SolverOptions()
-        self.options.validate()
+        if not options_checked:  # io.run_checked passes options io.check_inputs validated
+            self.options.validate()
         t0 = time.perf_counter()
         self.hmesh = build_mesh(self.radius, density, linear=(element == "q4"), edge_band=edge_band,
                                 band_floor=band_floor)

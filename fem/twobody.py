@@ -1,4 +1,4 @@
-"""Incremental Newton solver: two deformable hemispheres pressed together (DESIGN §4).
+"""Incremental Newton solver: two deformable hemispheres pressed together (docs/design.md §4).
 
 Scene: body 1 (radius R₁) above, pole at the origin, equatorial plane z = R₁
 moved down by the total approach h; body 2 (radius R₂) below, pole at the
@@ -626,11 +626,12 @@ class TwoBodySolver(CycleLegs):
 
     def __init__(self, material1: Material, radius1: float, material2: Material, radius2: float,
                  density: float = 1.0, element: str = "q8r", options: SolverOptions | None = None,
-                 edge_band: float = 0.0, band_floor: float | None = None):
+                 edge_band: float = 0.0, band_floor: float | None = None, *, options_checked: bool = False):
         if material1.is_rigid or material2.is_rigid:
             raise ValueError("both bodies of the two-body scene must be deformable (finite E)")
         self.options = options or SolverOptions()
-        self.options.validate()
+        if not options_checked:  # io.run_checked passes options io.check_inputs validated
+            self.options.validate()
         pair_tol = pair_tolerance(self.options)
         if self.options.penalty is not None and self.options.tol > pair_tol:
             self.options = replace(self.options, tol=pair_tol)

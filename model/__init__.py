@@ -1,4 +1,4 @@
-"""Closed-form unified contact model for two elastic–plastic spheres (DESIGN §1–3).
+"""Closed-form unified contact model for two elastic–plastic spheres (docs/design.md §1–3).
 
 Public API::
 

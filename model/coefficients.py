@@ -1,4 +1,4 @@
-"""Coefficient set of the level functions H̄(Λ), c²(Λ) (DESIGN §2), stored as versioned JSON.
+"""Coefficient set of the level functions H̄(Λ), c²(Λ) (docs/design.md §2), stored as versioned JSON.
 
 The default set is the calibrated file ``coefficients.json`` shipped inside this package
 (``model/coefficients.json`` in the repository, read with :mod:`importlib.resources`, so a
@@ -9,7 +9,7 @@ when asked for by name, ``load_coefficients("literature")``; a missing or unread
 file is an error, never a silent fallback. The JSON schema is documented in
 ``model/README.md``.
 
-Functional forms fixed by the schema (symbols of DESIGN §1–2):
+Functional forms fixed by the schema (symbols of docs/design.md §1–2):
 
 * Level III, hardening exponent n:  q_III(n) = prefactor · exp(Σ_k exp_poly[k] n^(k+1))
   for q = H̄, c²;

@@ -106,7 +106,7 @@ def _shaped(x: np.ndarray):
 
 def contact(s1: Sphere, s2: Sphere, h, coeffs: Coefficients | None = None,
             h_max=None) -> ContactState:
-    """Unified two-sphere contact law (DESIGN §3) evaluated at mutual approaches h.
+    """Unified two-sphere contact law (docs/design.md §3) evaluated at mutual approaches h.
 
     Parameters
     ----------
@@ -190,7 +190,7 @@ def _unload(p: UnifiedPair, chk, h: np.ndarray, hm: np.ndarray, below: np.ndarra
 
 def contact_from_radius(s1: Sphere, s2: Sphere, a, coeffs: Coefficients | None = None
                         ) -> UnifiedState:
-    """The unified model given the contact radius (DESIGN §3, forward direction).
+    """The unified model given the contact radius (docs/design.md §3, forward direction).
 
     Returns the full :class:`~spherecontact.model.unified.UnifiedState` (κ, ρ_1, ρ_2,
     p_m, h_1, h_2, h, F, dF/dh, Λ_1, Λ_2) as 1-D arrays for contact radii 0 < a ≤ a_max

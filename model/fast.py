@@ -1,6 +1,6 @@
 """Fast path for many contacts of one sphere pair: a monotone table of the exact solution.
 
-``ContactLaw(s1, s2)`` solves the unified model (DESIGN §3) once on a grid of contact
+``ContactLaw(s1, s2)`` solves the unified model (docs/design.md §3) once on a grid of contact
 radii and stores, against s = ln h, the cubic Hermite interpolants of
 
     ln F(s),  ln a(s),  φ(s) = h_1/h

@@ -1,4 +1,4 @@
-"""Level functions H̄(Λ) and c²(Λ) of the Brinell-type single-body relations (DESIGN §2).
+"""Level functions H̄(Λ) and c²(Λ) of the Brinell-type single-body relations (docs/design.md §2).
 
 | level | range            | H̄                      | c²                     |
 |-------|------------------|------------------------|------------------------|
@@ -275,7 +275,7 @@ def c2_and_slope(Lambda, coeffs: Coefficients, n=0.0):
 def finite_size_factor(x, poly: tuple[float, ...], x_max: float | None = None):
     """Factor f(x) = 1 + Σ_k poly[k] x^(k+1) and its log slope d ln f/d ln x.
 
-    f(0) = 1 exactly: the correction vanishes as x → 0 (DESIGN §2). Beyond ``x_max`` (the
+    f(0) = 1 exactly: the correction vanishes as x → 0 (docs/design.md §2). Beyond ``x_max`` (the
     largest calibrated ratio) ln f is continued to a constant (:func:`continue_beyond`), so a
     polynomial fitted up to x_max never turns f negative or F(h) non-monotone at large x.
     """

@@ -1,4 +1,4 @@
-"""Single-body global relations (DESIGN §2): one body pressed by a rigid surface of radius ρ.
+"""Single-body global relations (docs/design.md §2): one body pressed by a rigid surface of radius ρ.
 
 With x = a/ρ (all quantities are functions of a and ρ only through x, except the
 finite-size ratio when it is a/R):
@@ -181,7 +181,7 @@ def spread_average(flow, e, spread: float):
 def curvature_ratio(radius, rho_hertz):
     """z = R/ρ_H − 1 of a body of radius R whose Hertz relative radius is ρ_H (vectorised).
 
-    ρ_H = E'_i R*/E* (DESIGN §3): 0 for equal spheres, R/R_i against a rigid sphere of
+    ρ_H = E'_i R*/E* (docs/design.md §3): 0 for equal spheres, R/R_i against a rigid sphere of
     radius R_i; 0 for a flat body (R = inf, no collapse).
     """
     R = np.asarray(radius, dtype=float)
@@ -317,7 +317,7 @@ class FixedTerms(NamedTuple):
 
 @dataclass(frozen=True)
 class BodyLaw:
-    """Single-body law p_m(x), c²(x) of one deformable material (DESIGN §2)."""
+    """Single-body law p_m(x), c²(x) of one deformable material (docs/design.md §2)."""
 
     material: Material
     coeffs: Coefficients

@@ -1,4 +1,4 @@
-"""Two dissimilar spheres — the unified model (DESIGN §3).
+"""Two dissimilar spheres — the unified model (docs/design.md §3).
 
 The interface bends to a curvature κ; body i sees the relative radius ρ_i:
 
@@ -55,7 +55,7 @@ approaches along the branch in u instead (a(u) from g(a, u) = 0, then u from h).
 Domain (:attr:`UnifiedPair.domain`): h(a) and F(a) rise for every a > 0 (the large-
 deformation terms are continued to constants beyond their fitted range, ``levels.py``), but
 geometry bounds the approach: each deformable sphere's own approach stays within its radius,
-h_i ≤ R_i (h_i is the shortening of the hemisphere of height R_i, DESIGN §4; at h_i = R_i it
+h_i ≤ R_i (h_i is the shortening of the hemisphere of height R_i, docs/design.md §4; at h_i = R_i it
 is flattened completely). The first sphere to reach it as a grows gives a_max and
 h_max = h(a_max); approaches beyond h_max (radii beyond a_max) raise a ValueError naming h
 (a) and the allowed range. A deformable flat has no such bound. (A contact radius beyond a

@@ -1,6 +1,6 @@
 """spherecontact: contact force and area between two elastic–plastic spheres.
 
-Stages (DESIGN.md): ``fem`` (reference FE solver) → ``data`` → ``calibration``
+Stages (docs/design.md): ``fem`` (reference FE solver) → ``data`` → ``calibration``
 → ``model`` (closed-form unified law) ← ``validation``.
 """
 

@@ -1,8 +1,9 @@
 """Command line: ``spherecontact <stage> <command> …``.
 
-A thin layer: each stage module ``spherecontact.<stage>.cli`` provides
-``register(subparsers)`` that adds its commands and binds them to functions
-the tests call directly.
+A thin layer: each stage's ``cli`` module (:data:`STAGES`) provides ``register(subparsers)``
+that adds its commands and binds them to functions the tests call directly:
+``model curve|table``, ``fem run|render``, ``campaign run|design|increments``, ``calibrate``,
+``validate``, ``peers mdr``.
 """
 
 from __future__ import annotations
@@ -13,7 +14,9 @@ import re
 import sys
 import warnings
 
-STAGES = ("model", "fem")
+#: the modules whose ``register`` adds the commands, in the order of the help text
+STAGES = ("spherecontact.model.cli", "spherecontact.fem.cli", "spherecontact.campaign.cli",
+          "spherecontact.calibration.cli", "spherecontact.validation.cli")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -23,7 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="stage", required=True, metavar="STAGE")
     for stage in STAGES:
-        module = importlib.import_module(f"spherecontact.{stage}.cli")
+        module = importlib.import_module(stage)
         module.register(sub)
     return parser
 

@@ -17,8 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .fem.io import spheres_from_inputs
 from .model.coefficients import Coefficients, UnloadingCoefficients
+from .model.run_inputs import spheres_from_inputs
 from .model.unified import pair
 from .model.unloading import PeakFeatures, peak_features, unloading_law
 

@@ -25,7 +25,7 @@ def main(argv: list[str] | None = None) -> int:
     from spherecontact.fem.io import run_indentation, write_run
     from spherecontact.model import Material, Sphere, contact
     from spherecontact.model.coefficients import load_coefficients
-    from spherecontact.validation.peers import hertz, jackson_green
+    from spherecontact.peers import hertz, jackson_green
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--E-over-sy", type=float, default=200.0, help="E/σ_Y (σ_Y = 1), > 1")

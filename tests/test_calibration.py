@@ -7,19 +7,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from spherecontact.calibration import cli
-from spherecontact.calibration.crossval import FOLDS, cross_validate, material_folds
-from spherecontact.calibration.dataset import build_dataset, quantities, resample
-from spherecontact.calibration.fit import Residuals, fit, rms
-from spherecontact.calibration.forms import FORMS, predict, predict_exact
-from spherecontact.calibration.pipeline import calibrate, calibrate_runs, coefficient_file, load_runs
-from spherecontact.calibration.synthetic import (
+from calibration_synthetic import (
     CALIBRATION_CASES,
     hertz_result,
     model_result,
     write_database,
 )
+
+from spherecontact.calibration.crossval import FOLDS, cross_validate, material_folds
+from spherecontact.calibration.dataset import build_dataset, quantities, resample
+from spherecontact.calibration.fit import Residuals, fit, rms
+from spherecontact.calibration.forms import FORMS, predict, predict_exact
+from spherecontact.calibration.pipeline import calibrate, calibrate_runs, coefficient_file, load_runs
 from spherecontact.fem.io import Run
 from spherecontact.model import Material
 from spherecontact.model.cap import cap_gap_factor
@@ -52,6 +51,13 @@ SMALL = [c for c in CALIBRATION_CASES if c[0] in (
     "flat-E10", "flat-E100", "flat-E1000", "flat-E10000", "flat-K2-n0.3-E100",
     "flat-K2-n0.5-E1000", "sphere-E100", "sphere-K2-n0.3-E300")]
 
+
+
+def calibrate_cli(argv: list[str]) -> int:
+    """``spherecontact calibrate ARGV``."""
+    from spherecontact.cli import main
+
+    return main(["calibrate", *argv])
 
 def as_run(res) -> Run:
     """A RunResult as the reader's Run (what the database returns)."""
@@ -232,7 +238,7 @@ def test_missing_corrupt_and_empty_databases_get_clear_errors(tmp_path, small_db
     missing = tmp_path / "absent.h5"
     with pytest.raises(FileNotFoundError):
         calibrate(missing)
-    assert cli.main(["--db", str(missing), "--out", str(tmp_path / "c.json"), "--report", ""]) == 2
+    assert calibrate_cli(["--db", str(missing), "--out", str(tmp_path / "c.json"), "--report", ""]) == 2
     assert "not found" in capsys.readouterr().err
     garbage = tmp_path / "garbage.h5"
     garbage.write_bytes(b"this is not an HDF5 file\n" * 100)
@@ -243,7 +249,7 @@ def test_missing_corrupt_and_empty_databases_get_clear_errors(tmp_path, small_db
     truncated.write_bytes(data[: len(data) // 3])
     with pytest.raises(ValueError, match="truncated.h5"):
         calibrate(truncated)
-    assert cli.main(["--db", str(truncated), "--out", str(tmp_path / "c.json"), "--report", ""]) == 2
+    assert calibrate_cli(["--db", str(truncated), "--out", str(tmp_path / "c.json"), "--report", ""]) == 2
     assert "truncated.h5" in capsys.readouterr().err
     # a valid database without calibration runs
     empty = tmp_path / "empty.h5"
@@ -251,7 +257,7 @@ def test_missing_corrupt_and_empty_databases_get_clear_errors(tmp_path, small_db
     write_database(empty, [("validation-only", model_result(m, KNOWN_CO))], set_name="validation")
     with pytest.raises(ValueError, match="no converged calibration runs"):
         calibrate(empty)
-    assert cli.main(["--db", str(empty), "--out", str(tmp_path / "c.json"), "--report", ""]) == 2
+    assert calibrate_cli(["--db", str(empty), "--out", str(tmp_path / "c.json"), "--report", ""]) == 2
     assert "no converged calibration runs" in capsys.readouterr().err
     assert not (tmp_path / "c.json").exists()
 
@@ -261,9 +267,9 @@ def test_cli_writes_a_loadable_file_byte_identical_on_rerun(tmp_path, small_db, 
     db = tmp_path / "db.h5"
     shutil.copy(small_db, db)
     out1, out2 = tmp_path / "c1.json", tmp_path / "c2.json"
-    assert cli.main(["--db", str(db), "--out", str(out1), "--report", str(tmp_path / "rep"),
+    assert calibrate_cli(["--db", str(db), "--out", str(out1), "--report", str(tmp_path / "rep"),
                      "--forms", "seed,smooth"]) == 0
-    assert cli.main(["--db", str(db), "--out", str(out2), "--report", "", "--forms", "seed,smooth",
+    assert calibrate_cli(["--db", str(db), "--out", str(out2), "--report", "", "--forms", "seed,smooth",
                      "--workers", "1"]) == 0
     assert out1.read_bytes() == out2.read_bytes()  # also with the fits on 1 or 2 processes
     d = json.loads(out1.read_text())

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from calibration_synthetic import CALIBRATION_CASES, model_result
 from test_calibration import KNOWN_CO, SMALL, as_run
 
 from spherecontact.calibration.dataset import build_dataset, quantities
@@ -16,7 +17,6 @@ from spherecontact.calibration.pipeline import (
     coefficient_file,
     load_runs,
 )
-from spherecontact.calibration.synthetic import CALIBRATION_CASES, model_result
 from spherecontact.model.coefficients import Coefficients
 from spherecontact.model.single import effective_exponent, hardening_magnitude
 

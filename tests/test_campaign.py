@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from spherecontact.campaign import driver as fc
+from spherecontact.campaign.design import PARAMETERS, load_campaign, parse_campaign
 from spherecontact.data import Database, input_key
-from spherecontact.fem import campaign as fc
-from spherecontact.fem.design import PARAMETERS, load_campaign, parse_campaign
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY = """
@@ -25,6 +25,13 @@ mesh_density = 0.25
 options = {{dh_first = 0.001, dh_max = 0.005}}
 """
 
+
+
+def campaign_run(argv: list[str]) -> int:
+    """``spherecontact campaign run ARGV``."""
+    from spherecontact.cli import main
+
+    return main(["campaign", "run", *argv])
 
 def tiny(body: str, h_max: float = 0.01) -> str:
     return TINY.format(h_max=h_max) + body
@@ -194,14 +201,14 @@ def test_dry_run_and_exit_codes(tmp_path, capsys):
     toml = tmp_path / "c.toml"
     toml.write_text(tiny('[[calibration]]\nscene = "flat"\nE_over_sigma_y = [100, 200]\n'))
     db = tmp_path / "ref.h5"
-    assert fc.main(["--campaign", str(toml), "--db", str(db), "--dry-run"]) == 0
+    assert campaign_run(["--campaign", str(toml), "--db", str(db), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "flat-pp-E200-nu0.3" in out and "calibration: 2 cases (2 missing)" in out
     assert not db.exists()
-    assert fc.main(["--campaign", str(toml), "--db", str(db), "--set", "validation"]) == 2
+    assert campaign_run(["--campaign", str(toml), "--db", str(db), "--set", "validation"]) == 2
     assert "--set validation: the campaign has the sets calibration" in capsys.readouterr().err
-    assert fc.main(["--campaign", str(tmp_path / "none.toml"), "--db", str(db)]) == 2
-    assert fc.main(["--campaign", str(toml), "--db", str(db), "--workers", "0", "--only", "E100"]) == 0
+    assert campaign_run(["--campaign", str(tmp_path / "none.toml"), "--db", str(db)]) == 2
+    assert campaign_run(["--campaign", str(toml), "--db", str(db), "--workers", "0", "--only", "E100"]) == 0
     out = capsys.readouterr().out
     assert "calibration" in out and "wall/run" in out
     assert [r.case for r in Database(db).records()] == ["flat-pp-E100-nu0.3"]
@@ -215,10 +222,10 @@ def test_superseded_entries_are_listed_and_pruned(tmp_path, capsys):
     fc.run_campaign(load_campaign(toml), db_path, workers=0,
                     runner=lambda case: fc.execute(case) if "E100" in case.name else
                     fc.Outcome(case.key, "failed", "RuntimeError: no solver", 0.0))
-    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--prune"]) == 0
+    assert campaign_run(["--campaign", str(toml), "--db", str(db_path), "--prune"]) == 0
     assert "0 superseded entries removed" in capsys.readouterr().out
     h = Database(db_path).content_hash
-    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--compact"]) == 0
+    assert campaign_run(["--campaign", str(toml), "--db", str(db_path), "--compact"]) == 0
     assert f"{db_path}: " in capsys.readouterr().out and Database(db_path).content_hash == h
     # new solver options give both cases new keys: the old run and the old failure are superseded
     toml.write_text(tiny(body).replace("dh_max = 0.005", "dh_max = 0.004"))
@@ -226,10 +233,10 @@ def test_superseded_entries_are_listed_and_pruned(tmp_path, capsys):
     old = fc.superseded(changed, Database(db_path))
     assert sorted((r.case, r.status) for r in old) == [("flat-pp-E100-nu0.3", "converged"),
                                                         ("flat-pp-E200-nu0.3", "failed")]
-    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--dry-run"]) == 0
+    assert campaign_run(["--campaign", str(toml), "--db", str(db_path), "--dry-run"]) == 0
     out = capsys.readouterr().out
     assert "2 superseded database entries" in out and "calibration: 2 cases (2 missing)" in out
-    assert fc.main(["--campaign", str(toml), "--db", str(db_path), "--prune"]) == 0
+    assert campaign_run(["--campaign", str(toml), "--db", str(db_path), "--prune"]) == 0
     assert "2 superseded entries removed" in capsys.readouterr().out
     db = Database(db_path)
     assert len(db) == 0 and db.failed() == [] and fc.superseded(changed, db) == []
@@ -305,7 +312,7 @@ def test_killed_campaign_resumes(tmp_path):
     toml.write_text(tiny('[[calibration]]\nscene = "flat"\nE_over_sigma_y = [100, 120, 150, 200]\n',
                          h_max=0.02))
     db_path = tmp_path / "ref.h5"
-    cmd = [sys.executable, "-m", "spherecontact.fem.campaign", "--campaign", str(toml),
+    cmd = [sys.executable, "-m", "spherecontact.cli", "campaign", "run", "--campaign", str(toml),
            "--db", str(db_path), "--workers", "1"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     try:
@@ -350,7 +357,7 @@ def test_campaign_on_a_dask_cluster(tmp_path):
                                                        ("validation", "rsphere2-pp-E100-nu0.3")]
     _, run = db.runs(set="validation")[0]
     assert run.inputs["indenter_radius"] == 2.0
-    assert run.provenance["extra"]["entry_point"] == "spherecontact.fem.campaign"
+    assert run.provenance["extra"]["entry_point"] == "spherecontact campaign run"
 
 
 def test_a_result_the_writer_rejects_fails_its_case_not_the_campaign(tmp_path):

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from spherecontact.campaign.design import load_campaign, parse_campaign
 from spherecontact.data import Database
-from spherecontact.fem.design import load_campaign, parse_campaign
 
 ROOT = Path(__file__).resolve().parents[1]
 HEAD = '[defaults]\nh_max = 0.3\n'
@@ -156,7 +156,7 @@ def test_shipped_v2_design():
 
 
 def test_plan_runs_the_cheapest_cases_first():
-    from spherecontact.fem.campaign import plan
+    from spherecontact.campaign.driver import plan
 
     cases = parse_campaign(HEAD + '[[s]]\nscene = "flat"\nE_over_sigma_y = [10000, 10, 300]\n'
                                   '[[s]]\nscene = "two_body"\nE_over_sigma_y = 30\n'

@@ -6,8 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from spherecontact.fem.case_convergence import check_case, differences, rerun
+from fem_case_convergence import check_case, differences, rerun
 
 #: a campaign v2 flat's recorded inputs (options as the campaign writes them)
 INPUTS = {"edge_band": 0.03, "element": "q8r", "h_max": 0.3, "indenter_radius": math.inf,

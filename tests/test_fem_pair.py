@@ -172,7 +172,7 @@ def test_equal_pair_as_two_bodies_matches_the_symmetric_scene():
 
 def test_database_pairs_table_and_the_required_pairs():
     """The pair report tabulates the database's two-body runs; R4 and sy3 must reach 0.3."""
-    from spherecontact.fem.verification_pair import REQUIRED_PAIRS, _pairs_pass, database_pairs
+    from fem_verification_pair import REQUIRED_PAIRS, _pairs_pass, database_pairs
     rows = database_pairs(Path(__file__).resolve().parents[1] / "data" / "reference.h5")
     assert {r["case"].rsplit("-vs-", 1)[1] for r in rows} >= {s.removeprefix("vs-") for s in REQUIRED_PAIRS}
     assert all(r["contact"] in ("exact one-pass", "two-pass penalty 100") for r in rows)
@@ -223,7 +223,7 @@ def test_the_softer_sphere_is_the_slave_of_one_pass_contact():
 def test_hertz_check_figures_of_an_exact_and_a_perturbed_hertz_pair():
     """The Hertz check reads F(a_ref) against Hertz with E*, R* and h₁/h₂ against E'₂/E'₁:
     zero for the half-space solution itself, and the perturbation when F is 2 % high."""
-    from spherecontact.fem.verification_pair import HERTZ_PAIR, hertz_figures
+    from fem_verification_pair import HERTZ_PAIR, hertz_figures
     m1, m2 = HERTZ_PAIR["material"], HERTZ_PAIR["material2"]
     Es = 1.0 / (1.0 / m1.E_prime + 1.0 / m2.E_prime)
     Rs = 1.0 / (1.0 / HERTZ_PAIR["radius"] + 1.0 / HERTZ_PAIR["radius2"])

@@ -184,7 +184,8 @@ def test_a_rigid_obstacle_refuses_the_mortar_scheme():
 
 def test_pair_contacts_builds_the_five_discretisations_and_reads_the_split():
     """``fem.pair_contacts``: the passes of each contact, and one short run's figures."""
-    from spherecontact.fem.pair_contacts import CONTACTS, Scene, pair_solver, run_one
+    from fem_pair_contacts import CONTACTS, Scene, pair_solver, run_one
+
     from spherecontact.fem.segments import CATMULL_ROM, SMOOTH_EDGE
     from spherecontact.fem.twobody import SegmentContactPass
 

@@ -6,8 +6,8 @@ import numpy as np
 
 from spherecontact.fem.solver import SolverOptions
 from spherecontact.fem.twobody import TwoBodySolver
+from spherecontact.metrics import interp_loglog
 from spherecontact.model.material import Material
-from spherecontact.validation.metrics import interp_loglog
 
 
 def _run(contact_predictor: bool):

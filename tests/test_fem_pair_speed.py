@@ -1,10 +1,10 @@
-"""fem.pair_speed: the split comparison and the runs it builds from a stored pair."""
+"""studies/fem_pair_speed.py: the split comparison and the runs it builds from a stored pair."""
 
 import numpy as np
 import pytest
+from fem_pair_speed import CASES, PENALTY, flat_kwargs, pair_kwargs, split_difference
 
-from spherecontact.fem.design import load_campaign
-from spherecontact.fem.pair_speed import CASES, PENALTY, flat_kwargs, pair_kwargs, split_difference
+from spherecontact.campaign.design import load_campaign
 
 
 def _curves(h, split):
@@ -72,7 +72,7 @@ def test_a_surface_band_given_applies_to_the_pair_and_its_flat_run_alike():
                                         (["--edge-band", "0.03", "--band-floor", "0.05"], "--band-floor"),
                                         (["--interleave", "11"], "--interleave")])
 def test_a_bad_band_is_named_before_any_run(args, word, capsys):
-    from spherecontact.fem.pair_speed import main
+    from fem_pair_speed import main
 
     with pytest.raises(SystemExit):
         main(args)
@@ -81,7 +81,7 @@ def test_a_bad_band_is_named_before_any_run(args, word, capsys):
 
 def test_interleaved_rounds_alternate_the_flat_and_the_pair(monkeypatch):
     """Each round runs body 1's flat and then the pair; the ratio is that of the summed walls."""
-    from spherecontact.fem import pair_speed
+    import fem_pair_speed as pair_speed
 
     calls, walls = [], iter([10.0, 30.0, 12.0, 30.0])
     monkeypatch.setattr(pair_speed, "_timed", lambda kw: (calls.append("options" in kw), next(walls)))

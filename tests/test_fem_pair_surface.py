@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
+from fem_pair_surface import alternation, run_surfaces, second_differences
 
 from spherecontact.data import Database
-from spherecontact.fem.pair_surface import alternation, run_surfaces, second_differences
 
 
 def test_a_smooth_surface_does_not_alternate_and_a_sawtooth_does():

@@ -2,8 +2,7 @@
 
 import numpy as np
 import pytest
-
-from spherecontact.fem.reproduce import compare_loading
+from fem_reproduce import compare_loading
 
 
 def _curves(h, branch=None):
@@ -30,7 +29,7 @@ def test_cycles_are_left_out_of_the_comparison():
 
 
 def test_an_unknown_edge_fit_is_named_before_any_run(capsys):
-    from spherecontact.fem.reproduce import main
+    from fem_reproduce import main
 
     with pytest.raises(SystemExit):
         main(["--edge-fit", "free", "--cases"])

@@ -11,7 +11,7 @@ from spherecontact.fem.contact import RigidObstacle
 from spherecontact.fem.mesh import EDGE_BAND_MIN, build_mesh
 from spherecontact.fem.segment_penalty import SegmentPenalty
 from spherecontact.fem.solver import SolverOptions
-from spherecontact.validation.metrics import interp_loglog
+from spherecontact.metrics import interp_loglog
 
 
 def _arc(n_edges: int = 6, radius: float = 1.0, span: float = 0.3):
@@ -257,10 +257,9 @@ def test_increment_check_reports_the_largest_deviation_per_decade():
 @pytest.mark.parametrize(("flag", "value"), [("--h-end", "0.9"), ("--relative-step", "-1")])
 def test_increment_check_names_a_bad_window_or_step(flag, value, capsys):
     """The re-run's end and step bound are checked before any database is read or run made."""
-    from spherecontact.fem.increments import main
+    from spherecontact.cli import main
 
-    with pytest.raises(SystemExit):
-        main(["--db", "missing.h5", "--cases", "none", flag, value])
+    assert main(["campaign", "increments", "--db", "missing.h5", "--cases", "none", flag, value]) == 2
     assert f"{flag} must lie in" in capsys.readouterr().err
 
 

@@ -1,4 +1,4 @@
-"""End-to-end FE runs, short and coarse enough for CI (the full figures: fem/verification.py)."""
+"""End-to-end FE runs, short and coarse enough for CI (the full figures: studies/fem_verification.py)."""
 
 import math
 
@@ -8,7 +8,7 @@ import pytest
 from spherecontact.fem.contact import RigidObstacle
 from spherecontact.fem.solver import PHASES, IndentationSolver, SolverOptions
 from spherecontact.model import Material
-from spherecontact.validation.peers import jackson_green, jackson_green_critical
+from spherecontact.peers import jackson_green, jackson_green_critical
 
 E, NU = 200.0, 0.3
 EP = E / (1 - NU**2)
@@ -33,7 +33,7 @@ def test_hertz_force_against_contact_radius(elastic_run):
 
 
 def test_finite_sphere_carries_more_than_hertz(elastic_run):
-    """DESIGN §2: a hemisphere loaded through its equator is stiffer than the half-space."""
+    """docs/design.md §2: a hemisphere loaded through its equator is stiffer than the half-space."""
     c = elastic_run.curves
     ratio = np.interp(0.002, c["h"], c["F"] / (4 / 3 * EP * c["h"] ** 1.5))
     assert 1.01 < ratio < 1.035
@@ -252,7 +252,8 @@ def test_smoothness_rerun_of_some_cases_keeps_the_others(tmp_path, monkeypatch):
     """``--only`` re-measures the chosen cases and keeps every earlier one in the file."""
     import json
 
-    from spherecontact.fem import smoothness
+    import fem_smoothness as smoothness
+
     earlier = [{"label": c[0], "wall_s": 1.0, "scatter_F": 0.01, "edge_band": c[3],
                 "indenter_radius": "inf", "E_over_sigma_y": c[1]} for c in smoothness.CASES]
     (tmp_path / "smoothness.json").write_text(json.dumps(earlier))
@@ -271,7 +272,7 @@ def test_smoothness_records_the_solver_settings_each_figure_was_measured_with():
     one), so every measurement carries them and its date."""
     import re
 
-    from spherecontact.fem.smoothness import measure
+    from fem_smoothness import measure
     r = measure(50.0, np.inf, 0.0, {"tol": 1e-6, "predictor": "secant"}, h_max=0.002)
     assert r["status"] == "converged" and r["newton_tol"] == 1e-6 and r["predictor"] == "secant"
     assert re.fullmatch(r"\d{4}-\d{2}-\d{2}", r["date_utc"])

@@ -5,8 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from spherecontact.fem.verification import CAMPAIGN_BAND, LOCK_WINDOW, _run, _window_mean, plan
+from fem_verification import CAMPAIGN_BAND, LOCK_WINDOW, _run, _window_mean, plan
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -42,7 +41,7 @@ def test_run_builds_the_band_mesh_it_is_given():
 def test_a_run_on_another_runs_approaches_steps_to_them():
     """The mesh check without the increments' share: the refined run is stepped to the default
     run's converged approaches (``loading_approaches``), so both curves share their h."""
-    from spherecontact.fem.verification import loading_approaches
+    from fem_verification import loading_approaches
 
     opts = dict(dh_first=1e-4, dh_max=2e-4)
     coarse = _run("epp", 200.0, 1e-3, density=0.5, options=opts)
@@ -55,7 +54,7 @@ def test_a_run_on_another_runs_approaches_steps_to_them():
 def test_the_edge_fit_is_checked_on_the_standard_run_and_its_2x_mesh_alike():
     """The mesh check of the fitted contact edge compares like with like: the standard run with
     ``edge_fit`` "fitted", and the 2× mesh stepped to that run's approaches with the same option."""
-    from spherecontact.fem.verification import AFTER_POOL, EDGE_FITTED, SAME_STEPS, SAME_STEPS_FITTED
+    from fem_verification import AFTER_POOL, EDGE_FITTED, SAME_STEPS, SAME_STEPS_FITTED
 
     cases = plan(quick=False)
     assert cases[EDGE_FITTED] == cases["standard"] | {"options": {"edge_fit": "fitted"}}

@@ -1,8 +1,7 @@
 """The elastic-retrace measure of `make verify-cycles` on synthetic Hertz cycles."""
 
 import numpy as np
-
-from spherecontact.fem.verification_cycles import retrace, retrace_at_same_approach, unloading_approaches
+from fem_verification_cycles import retrace, retrace_at_same_approach, unloading_approaches
 
 
 def hertz_cycle(bump: float = 0.0) -> dict:
@@ -55,7 +54,7 @@ def test_retrace_at_the_same_approach_needs_no_interpolation():
 
 def test_small_contact_stiffness_is_judged_per_mesh():
     """Sneddon's limit is checked on the branches with a/R ≤ 0.05 only, separately per mesh."""
-    from spherecontact.fem.verification_cycles import LIMITS, stiffness_small
+    from fem_verification_cycles import LIMITS, stiffness_small
     stiff = [{"mesh": "coarse", "a_over_R": 0.03, "S_over_2Ea": 1.036, "elastic_sphere_dFdh_over_2Ea": 1.013},
              {"mesh": "coarse", "a_over_R": 0.3, "S_over_2Ea": 1.4, "elastic_sphere_dFdh_over_2Ea": 1.3},
              {"mesh": "fine", "a_over_R": 0.04, "S_over_2Ea": 0.99, "elastic_sphere_dFdh_over_2Ea": 1.0},

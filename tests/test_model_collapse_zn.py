@@ -8,13 +8,13 @@ import re
 
 import numpy as np
 import pytest
+from calibration_synthetic import model_result
 from test_calibration import KNOWN_CO, as_run
 from test_calibration_schema import COLLAPSE, v2
 from test_model_counter_surface import check_predict_and_jacobian
 
 from spherecontact.calibration.dataset import build_dataset
 from spherecontact.calibration.forms import FORMS
-from spherecontact.calibration.synthetic import model_result
 from spherecontact.model import Material
 from spherecontact.model.coefficients import Coefficients, CollapseLimit
 

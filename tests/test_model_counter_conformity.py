@@ -12,12 +12,12 @@ import warnings
 import numpy as np
 import pytest
 from _slopes import assert_body_log_slopes
+from calibration_synthetic import model_result
 from test_calibration import KNOWN_CO, as_run
 from test_model_counter_surface import check_predict_and_jacobian, check_rise_beyond_a_small_indenter
 
 from spherecontact.calibration.dataset import build_dataset
 from spherecontact.calibration.forms import FORMS, Form
-from spherecontact.calibration.synthetic import model_result
 from spherecontact.model import CalibrationRangeWarning, Material, Sphere, contact, default_coefficients
 from spherecontact.model.coefficients import COUNTER_BOUND, Coefficients
 from spherecontact.model.levels import counter_surface, level_weight

@@ -11,13 +11,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from _slopes import assert_body_log_slopes
+from calibration_synthetic import model_result
 from test_calibration import KNOWN_CO, as_run
 
 from spherecontact.calibration import fit as fitmod
 from spherecontact.calibration.dataset import build_dataset
 from spherecontact.calibration.forms import CANDIDATES, FORMS, predict, predict_exact
 from spherecontact.calibration.jacobian import residual_jacobian
-from spherecontact.calibration.synthetic import model_result
 from spherecontact.model import (
     CalibrationRangeWarning,
     Material,

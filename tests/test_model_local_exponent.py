@@ -10,12 +10,12 @@ import math
 import numpy as np
 import pytest
 from _slopes import assert_body_log_slopes
+from calibration_synthetic import model_result
 from test_calibration import KNOWN_CO, as_run
 from test_model_counter_surface import check_predict_and_jacobian
 
 from spherecontact.calibration.dataset import A_MIN_BAND_ELEMENTS, POLE_ELEMENT, build_dataset
 from spherecontact.calibration.forms import CANDIDATES, FORMS
-from spherecontact.calibration.synthetic import model_result
 from spherecontact.model import Material, Sphere, contact, load_coefficients
 from spherecontact.model.coefficients import Coefficients
 from spherecontact.model.single import BodyLaw, capped_exponent, local_exponent

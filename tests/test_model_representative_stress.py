@@ -7,12 +7,12 @@ import math
 
 import numpy as np
 import pytest
+from calibration_synthetic import model_result
 from test_calibration import KNOWN_CO, as_run
 from test_model_counter_surface import check_predict_and_jacobian
 
 from spherecontact.calibration.dataset import build_dataset
 from spherecontact.calibration.forms import CANDIDATES, FORMS
-from spherecontact.calibration.synthetic import model_result
 from spherecontact.model import Material, Sphere, contact, default_coefficients
 from spherecontact.model.coefficients import SPREAD_MAX, Coefficients
 from spherecontact.model.single import (

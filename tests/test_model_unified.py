@@ -1,4 +1,4 @@
-"""Unified two-sphere model (DESIGN §3): Hertz limit, scene limits, symmetry, inputs."""
+"""Unified two-sphere model (docs/design.md §3): Hertz limit, scene limits, symmetry, inputs."""
 
 import math
 import warnings

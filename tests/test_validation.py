@@ -5,25 +5,32 @@ import math
 import numpy as np
 import pytest
 
-from spherecontact.model import Material, Sphere, contact
-from spherecontact.validation import cases as vcases
-from spherecontact.validation import peers
-from spherecontact.validation.cases import Case, classes, reference_radius, spheres
-from spherecontact.validation.compare import W_ACCEPT, compare_case
-from spherecontact.validation.config import Thresholds, load_thresholds
-from spherecontact.validation.metrics import (
+from spherecontact import peers
+from spherecontact.metrics import (
     interp_loglog,
     pool,
     relative_error,
     summarise,
     trapezoid_weights,
 )
+from spherecontact.model import Material, Sphere, contact
+from spherecontact.validation import cases as vcases
+from spherecontact.validation.cases import Case, classes, reference_radius, spheres
+from spherecontact.validation.compare import W_ACCEPT, compare_case
+from spherecontact.validation.config import Thresholds, load_thresholds
 from spherecontact.validation.peer_scenes import NotApplicable, predict_peers
 from spherecontact.validation.tables import failures
 
 PP200 = {"E": 200.0, "nu": 0.3, "sigma_y": 1.0, "K": 0.0, "n": 1.0}
 TH = Thresholds()
 
+
+
+def _validate(argv: list[str]) -> int:
+    """``spherecontact validate ARGV``."""
+    from spherecontact.cli import main
+
+    return main(["validate", *argv])
 
 def make_case(name="run", scene="flat", material=PP200, h=None, scale_F=1.0, scale_a=1.0,
               set="validation", radius2=None, material2=None, indenter_radius=math.inf,
@@ -124,7 +131,7 @@ def test_peers_give_hertz_in_the_elastic_limit(scene, kw):
         assert np.allclose(pred[name].F, hz.F, rtol=1e-12), name
         assert np.allclose(pred[name].a, hz.a, rtol=1e-12), name
     # and the model tends to Hertz there too: its finite-size terms are linear in a/R
-    # (DESIGN §2), so the relative difference is at most of order a/R and vanishes with it
+    # (docs/design.md §2), so the relative difference is at most of order a/R and vanishes with it
     st = contact(s1, s2, h)
     x = hz.a / min(s1.radius, s2.radius)
     for q in ("F", "a"):
@@ -198,7 +205,7 @@ def _studies():
 
 
 def test_cli_exit_status_names_failing_runs(tmp_path, monkeypatch, capsys):
-    from spherecontact.validation.__main__ import main
+    main = _validate
 
     runs = {"validation": [make_case("fine_run", h=np.geomspace(2e-4, 0.3, 30)),
                            make_case("scaled_run", scale_F=1.1, h=np.geomspace(2e-4, 0.3, 30))],
@@ -253,7 +260,7 @@ def _fixture_database(path, cases):
 
 
 def test_report_from_a_fixture_database(tmp_path, capsys):
-    from spherecontact.validation.__main__ import main
+    main = _validate
 
     db = tmp_path / "reference.h5"
     val = [make_case("flat-E300", material={**PP200, "E": 300.0}, h=np.geomspace(2e-4, 0.3, 25)),
@@ -277,7 +284,7 @@ def test_report_from_tiny_fe_runs(tmp_path):
     """Real coarse FE runs (flat and a dissimilar pair) through the database and the CLI."""
     from spherecontact.data import Record, append_run, input_key
     from spherecontact.fem.io import run_indentation
-    from spherecontact.validation.__main__ import main
+    main = _validate
 
     m = Material(E=200.0, nu=0.3, sigma_y=1.0)
     db = tmp_path / "reference.h5"
@@ -297,21 +304,21 @@ def test_report_from_tiny_fe_runs(tmp_path):
 
 
 def test_scatter_measures_noise_not_curvature():
-    from spherecontact.validation.metrics import scatter
+    from spherecontact.metrics import scatter
 
     h = np.geomspace(1e-3, 0.3, 200)
     smooth = 2 * h**1.3 * (1 + h)
     assert scatter(h, smooth) < 1e-4
     wiggle = smooth * (1 + 0.01 * (-1) ** np.arange(h.size))
     assert 0.008 < scatter(h, wiggle) < 0.015  # ±1 % alternating noise (ends one-sided)
-    from spherecontact.validation.metrics import smooth_loglog
+    from spherecontact.metrics import smooth_loglog
 
     assert np.allclose(smooth_loglog(h, smooth), smooth, rtol=1e-4)
     assert np.max(np.abs(smooth_loglog(h, wiggle)[10:-10] / smooth[10:-10] - 1)) < 0.002
 
 
 def test_local_fit_reads_through_the_steps_that_the_point_value_sits_on():
-    from spherecontact.validation.metrics import local_fit_at
+    from spherecontact.metrics import local_fit_at
 
     h = np.geomspace(1e-3, 0.3, 200)
     smooth = 2 * h**1.3 * (1 + h)
@@ -327,8 +334,10 @@ def test_study_runs_outside_the_database(tmp_path):
     """Verification JSON (inputs from the verification plan) and study files (inputs stored)."""
     import json
 
-    from spherecontact.validation.fem_reports import load_study_files, load_verification_runs
+    from validation_fem_reports import load_verification_runs
+
     from spherecontact.validation.studies import variant
+    from spherecontact.validation.study_runs import load_study_files
 
     c = make_case("x", h=np.geomspace(2e-4, 0.3, 20))
     curves = {k: v.tolist() for k, v in c.curves.items()}
@@ -347,13 +356,14 @@ def test_study_runs_outside_the_database(tmp_path):
 
 
 def test_report_reads_no_uncommitted_verification_runs_by_default():
-    """The FE verification runs (reports/fem/run_*.json, git-ignored) enter the studies only on
-    request, so the same repository gives the same report on every machine."""
-    from spherecontact.validation.__main__ import _parser
+    """The FE verification runs (reports/fem/run_*.json, git-ignored) never enter the studies of
+    ``spherecontact validate`` (only ``studies/validation_fem_reports.py`` reads them), so the same
+    repository gives the same report on every machine."""
+    from spherecontact.cli import build_parser
 
-    args = _parser().parse_args([])
-    assert args.studies_fallback == ""
-    assert _parser().parse_args(["--studies-fallback", "reports/fem"]).studies_fallback == "reports/fem"
+    args = build_parser().parse_args(["validate"])
+    assert args.study_runs == "reports/validation/studies" and not hasattr(args, "studies_fallback")
+    assert args.converged_fe == "data/increments_v2.json"
 
 
 def test_small_contact_section_reads_the_model_against_converged_fe(tmp_path):

@@ -1,6 +1,6 @@
 """A validation case: one FE run from the reference database and the sphere pair it stands for.
 
-The FE scenes (DESIGN §4) and the pair the model is evaluated for:
+The FE scenes (docs/design.md §4) and the pair the model is evaluated for:
 
 * ``flat``: hemisphere R_1 on a rigid frictionless flat → Sphere(R_1, m_1) against
   Sphere(∞, rigid);
@@ -23,8 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..fem.io import loading_mask, reference_mask, spheres_from_inputs
+from ..fem.io import loading_mask, reference_mask
 from ..model import Material, Sphere
+from ..model.run_inputs import spheres_from_inputs
 
 __all__ = [
     "CLASSES",

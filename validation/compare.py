@@ -24,11 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import Coefficients, contact, contact_from_radius
-from ..model.levels import level as model_level
-from .cases import Case, classes, reference_radius, spheres
-from .config import Thresholds
-from .metrics import (
+from ..metrics import (
     EMPTY,
     LEVELS,
     Summary,
@@ -37,6 +33,10 @@ from .metrics import (
     summarise,
     trapezoid_weights,
 )
+from ..model import Coefficients, contact, contact_from_radius
+from ..model.levels import level as model_level
+from .cases import Case, classes, reference_radius, spheres
+from .config import Thresholds
 from .peer_scenes import PEERS, NotApplicable, predict_peers
 
 __all__ = ["W_ACCEPT", "W_LARGE", "QUANTITIES", "MethodErrors", "Comparison", "compare_case",

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..metrics import EMPTY, Summary, relative_error, smooth_loglog, summarise, trapezoid_weights
 from .compare import W_ACCEPT, Comparison
 from .config import Thresholds
-from .metrics import EMPTY, Summary, relative_error, smooth_loglog, summarise, trapezoid_weights
 from .tables import pct
 
 __all__ = ["GoalRow", "goal_rows", "goal_section"]

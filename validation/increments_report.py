@@ -1,8 +1,8 @@
 """The model against FE curves converged in the increment size where the contact is small.
 
-``make verify-increments`` (``fem/increments.py``) re-runs the first loading of the one-body
-validation runs, up to h/R = 0.01, with increments dh ≤ 0.03 h as well as the strain bound, and
-stores those curves (``reports/fem/increments_validation.json``). The stored campaign curves
+``spherecontact campaign increments`` (``fem/increments.py``) re-runs the first loading of the
+one-body validation runs, up to h/R = 0.01, with increments dh ≤ 0.03 h as well as the strain
+bound, and stores those curves as data (``data/increments_v2.json``). The stored campaign curves
 lie below them by up to several per cent where the contact is small (fem/README.md, "Increments where
 the contact is small"); this section reads the model's error over the acceptance window up to
 h/R = 0.01 against both, so that an error there is not mistaken for the model's alone. The
@@ -16,13 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from ..fem.increments import read_reruns
+from ..metrics import interp_loglog
 from .compare import W_ACCEPT, Comparison
-from .metrics import interp_loglog
 
 __all__ = ["load_converged", "small_contact_rows", "small_contact_section"]
 
-#: the file ``make verify-increments`` writes for the validation set
-DEFAULT_PATH = Path("reports/fem/increments_validation.json")
+#: the file ``spherecontact campaign increments`` writes for the validation set
+DEFAULT_PATH = Path("data/increments_v2.json")
 
 
 def load_converged(path=DEFAULT_PATH) -> dict | None:

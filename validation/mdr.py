@@ -42,8 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import interp_loglog
 from .cases import Case, is_perfectly_plastic, spheres
-from .metrics import interp_loglog
 
 __all__ = ["NAME", "DEFAULT_PATH", "StoredCurve", "MdrStore", "load_store", "mdr_scene", "mdr_curve_at",
            "version_label"]

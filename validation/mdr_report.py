@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import pool
 from .charts import DPI, pyplot
 from .compare import W_ACCEPT, Comparison
 from .mdr import NAME as MDR
 from .mdr import MdrStore, mdr_scene
-from .metrics import pool
 from .tables import cell, markdown_table, pct
 
 __all__ = ["mdr_section", "versus_table", "signed_errors_table", "sensitivity_table", "cost_rows",

@@ -36,8 +36,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import peers
 from ..model import Material
-from . import peers
 from .cases import Case, is_perfectly_plastic, spheres
 from .mdr import NAME as MDR
 from .mdr import MdrStore, mdr_curve_at

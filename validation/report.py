@@ -157,7 +157,7 @@ def build_report(validation: list[Case], studies: list[Case], coeffs: Coefficien
            "", "The whole-window figures above score a law also where it does not claim to hold (Hertz "
            "far beyond first yield, a rigid–plastic law in the elastic–plastic range). Here each peer "
            "is scored on the resolved FE points from h = 0 to the window end that lie inside its own "
-           "stated range (`validation/peers.py`, in the law's own variable: ω/ω_c, δ/δ_y, E'a/(σ_Y ρ)), "
+           "stated range (`spherecontact/peers.py`, in the law's own variable: ω/ω_c, δ/δ_y, E'a/(σ_Y ρ)), "
            "and the model on the same points; the model's whole-window figures are those of the "
            "tables above and below. Johnson's cavity model: error of p_m (its whole window is "
            "already its range).", "", range_tables(comps), "",

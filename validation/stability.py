@@ -25,13 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import Summary, interp_loglog, relative_error, summarise, trapezoid_weights
 from ..model import Coefficients, Material, Sphere, contact
 from ..model.calibrated_range import CalibratedRange, CalibrationRangeWarning
 from ..model.material import E_OVER_SIGMA_Y_RANGE
 from .cases import Case, reference_radius, spheres
 from .charts import DPI, pyplot
 from .config import Thresholds
-from .metrics import Summary, interp_loglog, relative_error, summarise, trapezoid_weights
 from .studies import DEFAULTS, Reference, energy_balance, standard_runs, variant
 from .tables import markdown_table, pct
 

@@ -29,11 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..metrics import Summary, interp_loglog, relative_error, smooth_loglog, summarise, trapezoid_weights
 from ..model import Coefficients, ContactLaw, contact
 from .cases import Case, reference_radius, spheres
 from .charts import DPI, pyplot
 from .config import Thresholds
-from .metrics import Summary, interp_loglog, relative_error, smooth_loglog, summarise, trapezoid_weights
 from .tables import markdown_table, pct
 
 __all__ = ["DEFAULTS", "variant", "Variant", "Reference", "standard_runs", "reference", "FEPoint",

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
+from ..metrics import EMPTY, LEVELS, Summary, pool, scatter
 from .cases import CLASSES
 from .compare import MODEL, W_ACCEPT, W_LARGE, Comparison
 from .config import Thresholds
-from .metrics import EMPTY, LEVELS, Summary, pool, scatter
 from .peer_scenes import PEERS, RANGE_TEXT
 
 __all__ = ["markdown_table", "pct", "cell", "run_table", "class_tables", "class_matrix",

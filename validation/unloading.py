@@ -43,11 +43,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..cycles import UnloadingCurve, law_branch, run_cycles
-from ..fem.io import spheres_from_inputs
 from ..model import Coefficients, contact, cycle, default_coefficients
 from ..model.coefficients import UnloadingCoefficients
+from ..model.run_inputs import spheres_from_inputs
+from ..peers import THORNTON_RANGE, jackson_green_critical, kogut_etsion_critical
 from .cases import Case, is_perfectly_plastic, scene_of
-from .peers import THORNTON_RANGE, jackson_green_critical, kogut_etsion_critical
 
 __all__ = ["UnloadingRow", "unloading_rows", "unloading_failures", "ekk_branch", "ekk_residual", "METHODS",
            "EKK", "EKK_RANGE", "RANGE_TEXT"]

@@ -22,7 +22,7 @@ move, the misfit is not a smooth function of these variables.
 **The c² step** (:func:`step_positions`): on flats the FE's d ln a/d ln h dips (to 0.32 for a
 stiff perfectly plastic sphere) where c² falls from its plateau; the dip's a/R is read as the
 minimum over a/R 0.25–0.7 of runs that reach a/R 0.62 and dip to ``STEP_DEPTH`` or below, and
-regressed on n (:func:`step_law`). ``python -m spherecontact.calibration.ceiling`` writes
+regressed on n (:func:`step_law`). ``python studies/calibration_ceiling.py`` writes
 ``reports/calibration/ceiling.json`` and ``ceiling.png``.
 """
 
@@ -36,11 +36,11 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import BSpline
 
-from ..model.single import representative_strain
-from .crossval import FOLDS, material_folds
-from .dataset import Dataset
-from .fit import log_errors
-from .forms import point_inputs, predict, raw_curvature_ratio
+from spherecontact.calibration.crossval import FOLDS, material_folds
+from spherecontact.calibration.dataset import Dataset
+from spherecontact.calibration.fit import log_errors
+from spherecontact.calibration.forms import point_inputs, predict, raw_curvature_ratio
+from spherecontact.model.single import representative_strain
 
 __all__ = ["SHIFT", "STEP_DEPTH", "EXTRA", "basis", "flow_curvature", "tensor_basis", "ceiling",
            "learning_curve", "step_positions", "step_law", "main"]
@@ -245,7 +245,7 @@ def step_law(rows: list[dict]) -> dict:
 
 
 def _chart(cal: Dataset, coeffs, rows: list[dict], law: dict, out: Path) -> Path:
-    from ..validation.charts import pyplot
+    from spherecontact.validation.charts import pyplot
 
     plt = pyplot()
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(12, 4.5))
@@ -275,11 +275,11 @@ def _chart(cal: Dataset, coeffs, rows: list[dict], law: dict, out: Path) -> Path
 def main(argv: list[str] | None = None) -> int:
     import warnings
 
-    from ..data import Database
-    from ..model import load_coefficients
-    from .dataset import build_dataset
+    from spherecontact.calibration.dataset import build_dataset
+    from spherecontact.data import Database
+    from spherecontact.model import load_coefficients
 
-    p = argparse.ArgumentParser(prog="python -m spherecontact.calibration.ceiling",
+    p = argparse.ArgumentParser(prog="studies/calibration_ceiling.py",
                                 description=__doc__.split("\n\n")[0])
     p.add_argument("--db", default="data/reference_v2.h5")
     p.add_argument("--coefficients", default="model/coefficients.json")

@@ -15,7 +15,7 @@ F"; data/README.md, "Surface band of the pairs").
 The bodies' meshes are rebuilt from the run's inputs (gmsh is deterministic) to find the surface
 nodes in the stored final mesh; a run whose stored mesh does not match is reported as such.
 
-``python -m spherecontact.fem.pair_surface --db data/reference_v2.h5 data/reference.h5 --out reports/fem``
+``python studies/fem_pair_surface.py --db data/reference_v2.h5 data/reference.h5 --out reports/fem``
 → ``sawtooth_pairs.json`` (about 10 s for the 16 stored pairs).
 """
 
@@ -27,8 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data import Database
-from .twobody import TwoBodySolver
+from spherecontact.data import Database
+from spherecontact.fem.twobody import TwoBodySolver
 
 #: the surface nodes within this fraction of the largest contact radius (reference radius)
 ZONE = 0.8

@@ -3,7 +3,7 @@
 Every function takes the approach (interference) as a float or array and returns
 arrays shaped like it; approaches ≤ 0 give zero force and contact radius. Symbols
 follow each paper; E' = E/(1 − ν²) (or the combined 1/E* = Σ(1 − ν_i²)/E_i),
-R the sphere radius (or R* for two spheres). The model stage (DESIGN §5) is checked
+R the sphere radius (or R* for two spheres). The model stage (docs/design.md §5) is checked
 against these laws; nothing here depends on ``spherecontact.model``.
 
 Every law carries its stated range of validity as data next to it (``*_RANGE``, in the
@@ -59,6 +59,7 @@ __all__ = [
     "thornton_unloading",
     "thornton_restitution",
     "hertz",
+    "first_yield_approach",
     "jackson_green_critical",
     "jackson_green",
     "kogut_etsion_critical",
@@ -129,6 +130,13 @@ def hertz(h, E_star: float, R_star: float) -> PeerCurve:
 
 
 # --------------------------------------------------------------------- Jackson & Green (2005)
+def first_yield_approach(R: float, E_prime: float, S_y: float, nu: float) -> float:
+    """Approach of first yield of Jackson & Green (2005), ω_c = R (π C S_y/(2E'))²,
+    C = 1.295 exp(0.736 ν) (ν of the deforming body; no check of the inputs: the FE solver
+    calls it per step set-up, :func:`jackson_green_critical` checks them)."""
+    return R * (math.pi * 1.295 * math.exp(0.736 * nu) * S_y / (2.0 * E_prime)) ** 2
+
+
 def jackson_green_critical(R: float, E_prime: float, S_y: float, nu: float):
     """Critical interference, load and yield-strength factor of Jackson & Green (2005).
 
@@ -141,7 +149,7 @@ def jackson_green_critical(R: float, E_prime: float, S_y: float, nu: float):
     """
     R, E_prime, S_y = _positive("R", R), _positive("E_prime", E_prime), _positive("S_y", S_y)
     C = 1.295 * math.exp(0.736 * nu)
-    omega_c = (math.pi * C * S_y / (2.0 * E_prime)) ** 2 * R
+    omega_c = first_yield_approach(R, E_prime, S_y, nu)
     P_c = 4.0 / 3.0 * (R / E_prime) ** 2 * (C * math.pi * S_y / 2.0) ** 3
     return omega_c, P_c, C
 

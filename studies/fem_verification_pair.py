@@ -1,6 +1,6 @@
-"""Verification of the two-deformable-body scene (DESIGN §4).
+"""Verification of the two-deformable-body scene (docs/design.md §4).
 
-``python -m spherecontact.fem.verification_pair [--quick] [--reuse] [--out DIR]``
+``python studies/fem_verification_pair.py [--quick] [--reuse] [--out DIR]``
 runs the cases below, writes ``DIR/pair_verification.json``, ``DIR/pair.md`` and
 ``DIR/pair.png``. σ_Y = 1, R₁ = 1 throughout.
 
@@ -39,13 +39,13 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
+from fem_verification import save_run, saved_runs
 
-from ..data import Database
-from ..model.material import Material
-from .contact import smooth_contact_radius
-from .io import run_indentation
-from .solver import SolverOptions
-from .verification import save_run, saved_runs
+from spherecontact.data import Database
+from spherecontact.fem.contact import smooth_contact_radius
+from spherecontact.fem.io import run_indentation
+from spherecontact.fem.solver import SolverOptions
+from spherecontact.model.material import Material
 
 NU = 0.3
 EPP = Material(E=200.0, nu=NU, sigma_y=1.0, K=0.0, n=1.0)
@@ -213,7 +213,7 @@ def evaluate(runs: dict, quick: bool) -> dict:
     return fig
 
 
-#: reference-database pairs that must reach h/R_min = 0.3 (DESIGN §4): name suffix → description
+#: reference-database pairs that must reach h/R_min = 0.3 (docs/design.md §4): name suffix → description
 REQUIRED_PAIRS = {"vs-sy3": "yield-stress ratio 3, equal radii", "vs-R4": "radius ratio 4, equal materials"}
 
 
@@ -317,7 +317,7 @@ def _report(fig: dict, png: str, outdir: Path, wall: float, reused: int = 0) -> 
     ok = {k: "pass" if v else "FAIL" for k, v in fig["pass"].items()}
     lines = [
         "# FE verification: two deformable spheres", "",
-        f"`python -m spherecontact.fem.verification_pair{' --quick' if fig['quick'] else ''}`, "
+        f"`python studies/fem_verification_pair.py{' --quick' if fig['quick'] else ''}`, "
         f"{wall:.0f} s{reuse}. Figures in `pair_verification.json`.", "",
         "| check | figure | limit | result |", "|---|---|---|---|",
         f"| equal EPP pair as two bodies (symmetric two-pass penalty {PENALTY:g}) vs one on a flat "
@@ -350,7 +350,7 @@ def _report(fig: dict, png: str, outdir: Path, wall: float, reused: int = 0) -> 
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m spherecontact.fem.verification_pair",
+    p = argparse.ArgumentParser(prog="studies/fem_verification_pair.py",
                                 description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="reports/fem", help="output directory")
     p.add_argument("--quick", action="store_true", help="coarse meshes and short runs (~1 min)")

@@ -1,7 +1,7 @@
 """Cost against smoothness of the FE force: scatter of F(h) and a(h) per contact discretisation.
 
 The FE scatter of a curve is max |ln y − local quadratic in ln h| over 11 increments
-(``validation.metrics.scatter``), here over the points with a/R ≥ 0.01 up to h/R = 0.3,
+(``spherecontact.metrics.scatter``), here over the points with a/R ≥ 0.01 up to h/R = 0.3,
 and per band of a/R. A node closing at the contact edge adds a ring of nearly full
 plastic pressure, a step of about 2 Δs/a in F (Δs the surface node spacing), so the
 scatter falls with the surface element size at the edge. Compared here, on one body
@@ -19,7 +19,7 @@ carries the date, the Newton tolerance and the predictor it was measured with: a
 scatter moves with them (fem/README.md, "Smoothness of F").
 
 Writes ``smoothness.json`` and ``smoothness.png`` (scatter of F against wall time).
-``python -m spherecontact.fem.smoothness --out reports/fem`` (~85 min on one core).
+``python studies/fem_smoothness.py --out reports/fem`` (~85 min on one core).
 """
 
 from __future__ import annotations
@@ -32,10 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.material import Material
-from ..validation.metrics import scatter
-from .contact import RigidObstacle
-from .solver import IndentationSolver, SolverOptions
+from spherecontact.fem.contact import RigidObstacle
+from spherecontact.fem.solver import IndentationSolver, SolverOptions
+from spherecontact.metrics import scatter
+from spherecontact.model.material import Material
 
 #: penalty contact integrated over the surface edges, scaled with the approach (P = 300)
 APPROACH = {"penalty": 300.0, "segment_points": 8, "penalty_scale": "approach"}

@@ -22,7 +22,7 @@ Runs (``--out`` gets ``cycles.md``, ``cycles_verification.json``, ``cycles.png``
   R_p = 4E*a_max³/(3F_max), h_res = h_max − (3F_max/(4E*√R_p))^{2/3},
   F = (4/3)E*√R_p (h − h_res)^{3/2}: a sanity check beside the FE, not a reference.
 
-``python -m spherecontact.fem.verification_cycles --out reports/fem`` (~10 min on 2 cores).
+``python studies/fem_verification_cycles.py --out reports/fem`` (~10 min on 2 cores).
 """
 
 from __future__ import annotations
@@ -35,10 +35,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.material import Material
-from ..validation.metrics import interp_loglog, scatter
-from .io import run_indentation
-from .solver import LOAD, RELOAD, UNLOAD, IndentationSolver, SolverOptions
+from spherecontact.fem.io import run_indentation
+from spherecontact.fem.solver import LOAD, RELOAD, UNLOAD, IndentationSolver, SolverOptions
+from spherecontact.metrics import interp_loglog, scatter
+from spherecontact.model.material import Material
 
 NU = 0.3
 CYCLES_AT = (0.001, 0.01, 0.1, 0.3)
@@ -196,7 +196,7 @@ def _branch(c: dict, cyc: dict, i: int):
 
 
 def _loglog_interp(x, xp, yp):
-    """:func:`~..validation.metrics.interp_loglog` for points given in any order."""
+    """:func:`spherecontact.metrics.interp_loglog` for points given in any order."""
     order = np.argsort(xp)
     return interp_loglog(x, xp[order], yp[order])
 
@@ -397,7 +397,7 @@ def _pct(x: float) -> str:
 
 def report(res: dict) -> str:
     lines = ["# Unloading and reloading cycles (one sphere on a rigid flat, ν = 0.3)", "",
-             "`python -m spherecontact.fem.verification_cycles` — " + __doc__.splitlines()[0], ""]
+             "`python studies/fem_verification_cycles.py` — " + __doc__.splitlines()[0], ""]
     lines += ["## Runs", "", "| run | status | increments | dofs | wall s |", "|---|---|---|---|---|"]
     lines += [f"| {n} | {r['status']} | {r['increments']} | {r['n_dofs']} | {r['wall_s']:.0f} |"
               for n, r in res["runs"].items()]

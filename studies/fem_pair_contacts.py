@@ -19,7 +19,7 @@ depend on which body is the slave; where it does, the split is ill-conditioned. 
 run: status, end, wall time, h₁/h and F at ``APPROACHES``, and the corner/midside sawtooth of
 both final surfaces (:func:`~.pair_surface.final_surfaces`).
 
-``python -m spherecontact.fem.pair_contacts --out reports/fem`` → ``split_contacts.json``
+``python studies/fem_pair_contacts.py --out reports/fem`` → ``split_contacts.json``
 (about 35 min on two cores). ``--mesh-density 2 --scenes 'E2 = 3 E1' --contacts points`` →
 ``split_contacts_density2.json``: whether the smooth split converges (about 18 min).
 """
@@ -35,11 +35,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from fem_pair_surface import final_surfaces
 
-from ..model.material import Material
-from .pair_surface import final_surfaces
-from .solver import SolverOptions
-from .twobody import ContactPass, MortarContactPass, SegmentPairWarning, TwoBodySolver
+from spherecontact.fem.solver import SolverOptions
+from spherecontact.fem.twobody import ContactPass, MortarContactPass, SegmentPairWarning, TwoBodySolver
+from spherecontact.model.material import Material
 
 #: relative penalty of the approach scaling (the bodies sink in by about h/P)
 PENALTY = 3000.0

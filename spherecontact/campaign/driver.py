@@ -1,6 +1,6 @@
 """Run an FE campaign into the reference database, in parallel, resumable.
 
-``python -m spherecontact.fem.campaign --campaign data/campaign.toml --db data/reference.h5``
+``spherecontact campaign run --campaign data/campaign_v2.toml --db data/reference_v2.h5``
 
 The campaign file (:mod:`.design`) expands to cases; cases whose key is already
 in the database are skipped (``--retry-failed`` / ``--retry-stopped`` rerun
@@ -22,7 +22,6 @@ them and ``--prune`` removes them, so a set never holds two runs of one case.
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import datetime as _dt
 import json
@@ -38,17 +37,17 @@ from dataclasses import dataclass
 from multiprocessing import get_context
 from pathlib import Path
 
-from ..data import Database, Record, append_run, compact, remove_entries, remove_stale_temporaries
-from .design import Campaign, Case, load_campaign
-from .io import old_plastic_start, provenance, run_indentation
-from .solver import RunResult
+from ..data import Database, Record, append_run, remove_entries, remove_stale_temporaries
+from ..fem.io import old_plastic_start, provenance, run_indentation
+from ..fem.solver import RunResult
+from .design import Campaign, Case
 
 __all__ = ["Outcome", "execute", "plan", "superseded", "prune", "run_campaign", "summarize",
-           "format_summary", "main"]
+           "format_summary", "select_sets", "dry_run"]
 
 #: thread counts of the numerical libraries in local workers (one core per run)
 THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-ENTRY_POINT = "spherecontact.fem.campaign"
+ENTRY_POINT = "spherecontact campaign run"
 
 
 # ============================================================================ one case
@@ -475,81 +474,12 @@ def dry_run(campaign: Campaign, db_path, sets=None, only: str | None = None) -> 
 
 
 # ============================================================================ command line
-def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
-        prog=f"python -m {ENTRY_POINT}",
-        description="Run the FE campaign into the reference database: cases already there are "
-                    "skipped, the rest run in parallel and are appended as they finish.")
-    p.add_argument("--campaign", default="data/campaign.toml", help="campaign file (TOML)")
-    p.add_argument("--db", default="data/reference.h5", help="reference database (HDF5)")
-    p.add_argument("--set", default="all", help="set to run: a set name of the campaign, or all")
-    p.add_argument("--only", metavar="SUBSTRING", help="only cases whose name contains SUBSTRING")
-    p.add_argument("--workers", type=int, default=None,
-                   help="local worker processes (default: number of cores; 0: in this process)")
-    p.add_argument("--scheduler", metavar="tcp://HOST:PORT",
-                   help="run on this Dask scheduler instead of local processes")
-    p.add_argument("--retry-failed", action="store_true", help="rerun cases recorded as failed")
-    p.add_argument("--retry-stopped", action="store_true",
-                   help="rerun cases stored as stopped (e.g. after raising max_wall_s) and replace them")
-    p.add_argument("--refresh-start", action="store_true",
-                   help="rerun stored runs whose first step was larger than today's solver takes "
-                        "(their first increments are left out as a transient) and replace them "
-                        "when the re-run converges")
-    p.add_argument("--prune", action="store_true",
-                   help="remove the database entries no case of the campaign produces (superseded "
-                        "inputs or options), print them, and run nothing")
-    p.add_argument("--compact", action="store_true",
-                   help="rewrite the database with one copy of each mesh and the space of replaced "
-                        "runs reclaimed, print the sizes, and run nothing")
-    p.add_argument("--dry-run", action="store_true",
-                   help="list the cases, their keys and whether they are in the database; run nothing")
-    return p
 
 
-def _sets(campaign: Campaign, name: str):
+def select_sets(campaign: Campaign, name: str):
+    """The sets to run: None for ``"all"``, else ``{name}`` (ValueError for a set the campaign lacks)."""
     if name == "all":
         return None
     if name not in campaign.sets:
         raise ValueError(f"--set {name}: the campaign has the sets {', '.join(campaign.sets)} (or all)")
     return {name}
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Exit 0 when every selected case is in the database and none failed, 1 otherwise, 2 on bad input."""
-    args = build_parser().parse_args(argv)
-    try:
-        if args.workers is not None and args.workers < 0:
-            raise ValueError(f"--workers must be >= 0, got {args.workers}")
-        if args.workers is not None and args.scheduler:
-            raise ValueError("--workers applies to local runs; a Dask cluster brings its own workers")
-        campaign = load_campaign(args.campaign)
-        sets = _sets(campaign, args.set)
-        if args.dry_run:
-            print(dry_run(campaign, args.db, sets, args.only))
-            return 0
-        if args.compact:
-            before, after = compact(args.db)
-            print(f"{args.db}: {before / 1e6:.2f} MB -> {after / 1e6:.2f} MB")
-            return 0
-        if args.prune:
-            removed = prune(campaign, args.db)
-            for r in removed:
-                print(f"removed {r.set} {r.case} {r.key} ({r.status})")
-            print(f"{len(removed)} superseded entries removed from {args.db}")
-            return 0
-        summary = run_campaign(campaign, args.db, sets=sets, only=args.only, workers=args.workers,
-                               scheduler=args.scheduler, retry_failed=args.retry_failed,
-                               retry_stopped=args.retry_stopped,
-                               refresh_start=args.refresh_start)
-    except ValueError as err:
-        print(f"{ENTRY_POINT}: error: {err}", file=sys.stderr)
-        return 2
-    print(format_summary(summary))
-    if Path(args.db).exists():
-        print(f"summary -> {args.db}.summary.json")
-    bad = summary["total"]["failed"] + summary["total"]["missing"]
-    return 0 if bad == 0 else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())

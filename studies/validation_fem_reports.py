@@ -1,40 +1,32 @@
-"""Study runs outside the database: the FE verification runs and the validation's own study runs.
+"""The validation's own FE study runs and the FE verification runs as validation cases.
 
-Used for the speed–accuracy chart and the stability section only when the database
-holds no ``studies`` set (the report then names this source).
+Checks: how the model's error against the standard case (E/σ_Y = 200, ν = 0.3, h/R = 0.3, rigid
+flat) moves with the FE's mesh density, strain increment, element, approach and contact penalty
+(:data:`STUDY_VARIANTS`), i.e. the FE side of the validation report's speed–accuracy chart and
+stability section.
 
-**Verification runs.**
-``make verify-fem`` saves each of its runs as JSON (curves, timings, residuals); their
-inputs are those of ``spherecontact.fem.verification.plan`` (ν = 0.3, σ_Y = 1, R = 1,
-rigid flat). Runs used:
-
-* ``standard``, ``standard_fine`` (mesh density 2), ``standard_dt2`` (strain increment
-  0.0025): the refinement series of the standard case (E/σ_Y = 200, h/R = 0.3);
-* ``lock_q4``, ``lock_q8r`` (and ``_fine``): the locking study (E/σ_Y = 10⁴);
-* ``large_*``: runs to h/R = 0.5 (the extreme-h/R study).
-
-**Study runs** (:data:`STUDY_VARIANTS`, written by ``python -m
-spherecontact.validation.fem_reports --out reports/validation/studies``): variants of
-the standard case, all with the current solver and timed on this machine one at a time:
-mesh densities 0.5, 1, 2; strain increments 0.0025–0.02; the locking element on the
-standard case; an extreme approach h/R = 0.6; penalty contact at relative stiffnesses
-0.01–100 (``SolverOptions.penalty``). They take precedence over verification runs
-with the same inputs. Each is a JSON
-file ``<name>.json`` with ``inputs``, ``curves``, ``status``, ``reason``, ``timings``.
+Writes: ``python studies/validation_fem_reports.py --out reports/validation/studies [NAME …]``
+runs the missing variants one after another into ``OUT/<name>.json`` (``inputs``, ``curves``,
+``status``, ``reason``, ``timings``), which ``spherecontact validate`` reads when the database
+holds no ``studies`` set (``spherecontact.validation.study_runs``).
+:func:`load_fallback` adds the runs of ``studies/fem_verification.py`` saved as
+``run_<name>.json`` (``STUDY_RUNS``: the standard case's refinement series, the locking study,
+the runs to h/R = 0.5) to them.
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 from pathlib import Path
 
 import numpy as np
 
-from .cases import Case
+from spherecontact.validation.cases import Case
+from spherecontact.validation.study_runs import load_study_files
 
-__all__ = ["STUDY_RUNS", "STUDY_VARIANTS", "load_verification_runs", "load_study_files",
-           "load_fallback", "run_study_variants"]
+__all__ = ["STUDY_RUNS", "STUDY_VARIANTS", "load_verification_runs", "load_fallback", "run_study_variants"]
 
 STUDY_RUNS = ("standard", "standard_fine", "standard_dt2", "lock_q4", "lock_q8r", "lock_q4_fine",
               "lock_q8r_fine", "large_epp50", "large_epp500", "large_ludwik")
@@ -60,8 +52,9 @@ STUDY_VARIANTS = {
 
 
 def _inputs(spec: dict) -> dict:
-    from ..fem.solver import SolverOptions
-    from ..fem.verification import NU
+    from fem_verification import NU
+
+    from spherecontact.fem.solver import SolverOptions
 
     E = float(spec["E_over_sy"])
     material = {"E": E, "nu": NU, "sigma_y": 1.0, "K": float(spec.get("K", 0.0)),
@@ -74,7 +67,7 @@ def _inputs(spec: dict) -> dict:
 
 def load_verification_runs(directory) -> list[Case]:
     """Cases of the FE verification runs found in ``directory`` (empty list if none)."""
-    from ..fem.verification import plan
+    from fem_verification import plan
 
     directory = Path(directory)
     specs = plan(quick=False)
@@ -104,30 +97,6 @@ def load_verification_runs(directory) -> list[Case]:
     return out
 
 
-def _case(name: str, d: dict, inputs: dict, source: str) -> Case:
-    curves = {k: np.asarray(v, dtype=float) for k, v in d["curves"].items()}
-    wall = float(d.get("timings", {}).get("wall_s", math.nan))
-    params = {"scene": "flat", "mesh_density": float(inputs.get("mesh_density", 1.0)),
-              "strain_increment": float(inputs.get("options", {}).get("strain_increment", 0.005)),
-              "element": inputs.get("element", "q8r")}
-    return Case(key=f"file:{name}", set="studies", name=name, params=params, inputs=inputs,
-                curves=curves, status=d.get("status", "converged"), reason=d.get("reason", ""),
-                wall_s=wall, provenance={"timings": d.get("timings", {}), "wall_s": wall,
-                                         "source": source})
-
-
-def load_study_files(directory) -> list[Case]:
-    """Cases of the study-run files ``directory/*.json`` (empty list if none)."""
-    out = []
-    for path in sorted(Path(directory).glob("*.json")):
-        try:
-            d = json.loads(path.read_text())
-            out.append(_case(path.stem, d, d["inputs"], str(path)))
-        except (OSError, ValueError, KeyError, TypeError):
-            continue
-    return out
-
-
 def _signature(c: Case) -> tuple:
     i = c.inputs
     m = i["material"]
@@ -147,9 +116,9 @@ def run_study_variants(out_dir, names=None) -> list[Path]:
     """Run the missing :data:`STUDY_VARIANTS` one after another; write ``out_dir/<name>.json``."""
     import time
 
-    from ..fem.io import run_indentation
-    from ..fem.solver import SolverOptions
-    from ..model import Material
+    from spherecontact.fem.io import run_indentation
+    from spherecontact.fem.solver import SolverOptions
+    from spherecontact.model import Material
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -176,11 +145,14 @@ def run_study_variants(out_dir, names=None) -> list[Path]:
     return written
 
 
-if __name__ == "__main__":
-    import argparse
-
-    parser = argparse.ArgumentParser(description="Run the validation's own FE study runs.")
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="reports/validation/studies")
     parser.add_argument("names", nargs="*", help=f"subset of {', '.join(STUDY_VARIANTS)}")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     run_study_variants(args.out, args.names)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

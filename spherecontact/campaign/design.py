@@ -43,11 +43,11 @@ import numpy as np
 from scipy.stats import qmc
 
 from ..data import input_key
+from ..fem.assembly import ELEMENTS
+from ..fem.mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN, check_band_floor
+from ..fem.solver import SolverOptions
 from ..model.material import Material
-from .assembly import ELEMENTS
-from .io import material_from_description
-from .mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN, check_band_floor
-from .solver import SolverOptions
+from ..model.run_inputs import material_from_description
 
 __all__ = ["PARAMETERS", "SCENES", "Param", "Case", "Campaign", "load_campaign", "parse_campaign",
            "run_kwargs"]

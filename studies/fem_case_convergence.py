@@ -9,7 +9,7 @@ relative difference of F and a of the density-1 run and of the stored loading cu
 the density-2 run (linear interpolation in ln h). Results accumulate in
 ``case_convergence.json`` by case name.
 
-    python -m spherecontact.fem.case_convergence --case flat-pp-E1000-nu0.3 [...] --out reports/fem
+    python studies/fem_case_convergence.py --case flat-pp-E1000-nu0.3 [...] --out reports/fem
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..validation.metrics import interp_loglog
-from .design import run_kwargs
-from .io import run_indentation
+from spherecontact.campaign.design import run_kwargs
+from spherecontact.fem.io import run_indentation
+from spherecontact.metrics import interp_loglog
 
 __all__ = ["A_OVER_R", "rerun", "differences", "check_case", "main"]
 

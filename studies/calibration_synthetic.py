@@ -1,5 +1,11 @@
 """Synthetic runs and databases for tests and demonstrations (no FE involved).
 
+Checks: the calibration's reading and fitting on curves whose answer is known — Hertz curves must
+give H̄ = 4Λ/(3π) and c² = 1/2, the model's own curves must give back its coefficients.
+Writes: ``python studies/calibration_synthetic.py --out /tmp/synthetic.h5 [--hertz]`` a reference
+database of such runs over the calibration grid (:data:`CALIBRATION_CASES`), which
+``spherecontact calibrate --db /tmp/synthetic.h5`` reads like the FE database.
+
 * :func:`hertz_result` — curves of exact Hertz contact (F = 4/3 E' √ρ h^{3/2}, a² = ρ h)
   for a given material and scene: the dataset must give H̄ = 4Λ/(3π) and c² = 1/2.
 * :func:`model_result` — curves of the closed-form model with a given coefficient set:
@@ -14,15 +20,16 @@ profiles and the final mesh are placeholders.
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
 
-from ..fem.solver import RunResult
-from ..model import Material, Sphere, contact
-from ..model.coefficients import Coefficients
-from .check import quiet_range_warnings
-from .dataset import relative_radius
+from spherecontact.calibration.check import quiet_range_warnings
+from spherecontact.calibration.dataset import relative_radius
+from spherecontact.fem.solver import RunResult
+from spherecontact.model import Material, Sphere, contact
+from spherecontact.model.coefficients import Coefficients
 
 __all__ = ["CALIBRATION_CASES", "hertz_result", "model_result", "write_database"]
 
@@ -97,8 +104,7 @@ def write_database(path, results: list[tuple[str, RunResult]], date_utc: str = "
                    set_name: str = "calibration") -> None:
     """Append ``(case, result)`` pairs to the reference database ``path`` (created if missing)."""
     from spherecontact.data import Record, append_run, input_key
-
-    from ..fem.io import provenance
+    from spherecontact.fem.io import provenance
 
     for case, res in results:
         prov = provenance(res)
@@ -111,3 +117,24 @@ def write_database(path, results: list[tuple[str, RunResult]], date_utc: str = "
         rec = Record(key=key, set=set_name, case=case, status=res.status, reason=res.reason,
                      wall_s=0.0, inputs=res.inputs, params=params)
         append_run(path, rec, res, prov)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--out", required=True, help="database to write (HDF5; appended to when present)")
+    p.add_argument("--hertz", action="store_true", help="Hertz curves instead of the model's")
+    p.add_argument("--h-max", type=float, default=0.3, help="largest approach over the radius")
+    args = p.parse_args(argv)
+    from spherecontact.model import default_coefficients
+
+    coeffs = default_coefficients()
+    results = [(case, hertz_result(m, indenter_radius=Ri, h_max=args.h_max) if args.hertz
+                else model_result(m, coeffs, indenter_radius=Ri, h_max=args.h_max))
+               for case, m, Ri in CALIBRATION_CASES]
+    write_database(args.out, results)
+    print(f"wrote {len(results)} synthetic runs -> {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -17,7 +17,7 @@ the reference contact radius vs Hertz with E*, R* and h₁/h₂ vs E′₂/E′�
 Each pair's record and its flat run's carry the milliseconds per Newton iteration, whole and by
 phase (:func:`~.solver.iteration_split`), which is where a pair's cost against the flat's is read.
 
-``python -m spherecontact.fem.pair_speed --out reports/fem`` → ``approach_pairs.json`` (~4 min);
+``python studies/fem_pair_speed.py --out reports/fem`` → ``approach_pairs.json`` (~4 min);
 ``--segment-points 3``: the same with the penalty at 3 Gauss points per edge (two passes, the
 convention of campaign v2's pairs of equal yield stress) → ``approach_pairs_points3.json``. Their
 smooth split differs from the stored nodal runs' by design (fem/README.md, "Contact").
@@ -36,14 +36,14 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from fem_reproduce import compare_loading
+from fem_verification_pair import HERTZ_PAIR, hertz_figures
 
-from ..data import Database
-from .design import load_campaign
-from .io import run_indentation
-from .mesh import check_band_floor, check_edge_band
-from .reproduce import compare_loading
-from .solver import SolverOptions, iteration_split
-from .verification_pair import HERTZ_PAIR, hertz_figures
+from spherecontact.campaign.design import load_campaign
+from spherecontact.data import Database
+from spherecontact.fem.io import run_indentation
+from spherecontact.fem.mesh import check_band_floor, check_edge_band
+from spherecontact.fem.solver import SolverOptions, iteration_split
 
 #: the equal-hardness pairs of campaign v1 (penalty contact, default mesh, h/R 0.3)
 CASES = ("two-pp-E200-nu0.3-vs-R2", "two-pp-E200-nu0.3-vs-R4", "two-pp-E200-nu0.3-vs-E600")

@@ -8,7 +8,7 @@ median of ln(new/stored), the largest one the maximum, beside the stored curve's
 scatter (max |ln y − local quadratic| over 11 increments). Two noisy curves may differ by up
 to the sum of their scatters.
 
-``python -m spherecontact.fem.reproduce --out reports/fem`` → ``reproduce.json`` (``--cases``
+``python studies/fem_reproduce.py --out reports/fem`` → ``reproduce.json`` (``--cases``
 re-runs some cases and keeps the others' earlier rows; ``--edge-fit fitted --name F`` re-runs them
 with the contact radius's edge exponent fitted, ``contact.contact_edge``).
 """
@@ -22,11 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data import Database
-from ..validation.metrics import interp_loglog, scatter
-from .contact import EDGE_FITS
-from .design import load_campaign
-from .io import loading_mask, run_indentation
+from spherecontact.campaign.design import load_campaign
+from spherecontact.data import Database
+from spherecontact.fem.contact import EDGE_FITS
+from spherecontact.fem.io import loading_mask, run_indentation
+from spherecontact.metrics import interp_loglog, scatter
 
 #: one case per scene: a flat, a rigid sphere, two bodies (exact contact)
 CASES = ("flat-pp-E200-nu0.35", "rsphere2-pp-E200-nu0.3", "two-pp-E200-nu0.3-vs-sy3")

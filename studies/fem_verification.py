@@ -1,6 +1,6 @@
-"""Verification of the FE solver against independent references (DESIGN §5, issue 3).
+"""Verification of the FE solver against independent references (docs/design.md §5, issue 3).
 
-``python -m spherecontact.fem.verification [--quick] [--out DIR]`` runs every case,
+``python studies/fem_verification.py [--quick] [--out DIR]`` runs every case,
 writes ``DIR/fem_verification.json`` (the figures), ``DIR/index.md`` and PNG charts.
 Cases:
 
@@ -8,7 +8,7 @@ Cases:
   F = 4E'a³/(3R) for a/R ∈ [0.02, 0.06] (Hertz 1882; a in the reference
   configuration, as in linear theory); the deformed radius differs by Hertz's
   radial surface displacement u_r(a)/a = −2(1−2ν)/(3π(1−ν)) a/R (Johnson 1985,
-  eq. 3.41); F(h) above Hertz by the finite-sphere term (DESIGN §2).
+  eq. 3.41); F(h) above Hertz by the finite-sphere term (docs/design.md §2).
 * ``jackson_green``: elastic–perfectly plastic E/σY = 200 and 1000 up to
   h = 100 ω_c against the Jackson & Green (2005) FE fit.
 * ``mesh``: default against 2× refined mesh, F within 0.5 %, a within 1 % at
@@ -36,10 +36,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.material import Material
-from ..validation.metrics import local_fit_at
-from .contact import RigidObstacle
-from .solver import IndentationSolver, SolverOptions
+from spherecontact.fem.contact import RigidObstacle
+from spherecontact.fem.solver import IndentationSolver, SolverOptions
+from spherecontact.metrics import local_fit_at
+from spherecontact.model.material import Material
 
 NU = 0.3
 #: issue "FE reference v2": the standard run's wall time alone and its Newton iterations per increment
@@ -113,7 +113,7 @@ def _at(run: dict, key: str, h: float) -> float:
 
 
 def _jg_omega_c(E_over_sy: float) -> float:
-    from ..validation.peers import jackson_green_critical
+    from spherecontact.peers import jackson_green_critical
 
     return jackson_green_critical(1.0, E_over_sy / (1 - NU**2), 1.0, NU)[0]
 
@@ -178,7 +178,7 @@ def _convergence_order(residuals: list[list[float]]) -> float:
 
 def evaluate(runs: dict, quick: bool) -> dict:
     """Figures and pass/fail of every check from the finished runs."""
-    from ..validation.peers import jackson_green
+    from spherecontact.peers import jackson_green
 
     out: dict = {}
     # ---- Hertz
@@ -319,7 +319,7 @@ def _plots(runs: dict, figures: dict, outdir: Path) -> list[str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..validation.peers import jackson_green
+    from spherecontact.peers import jackson_green
 
     names = []
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
@@ -385,7 +385,7 @@ def _plots(runs: dict, figures: dict, outdir: Path) -> list[str]:
 def _report(figures: dict, pngs: list[str], outdir: Path, wall: float, quick: bool) -> None:
     h = figures["hertz"]
     lines = [f"# FE solver verification{' (quick)' if quick else ''}", "",
-             f"Made by `python -m spherecontact.fem.verification{' --quick' if quick else ''}` "
+             f"Made by `python studies/fem_verification.py{' --quick' if quick else ''}` "
              f"in {wall:.0f} s; its {figures.get('_runs', 0)} runs took {figures.get('_runs_wall_s', 0):.0f} s "
              f"of wall time in all ({figures.get('_reused', 0)} reused from earlier with --reuse); "
              "figures in `fem_verification.json`.", "",

@@ -1,7 +1,7 @@
 """Design of a campaign at a glance: its points in parameter space and its table of runs.
 
-``python -m spherecontact.fem.design_report --campaign data/campaign_v2.toml
---db data/reference_v2.h5 --out reports/campaign`` writes
+``spherecontact campaign design --campaign data/campaign_v2.toml
+--db data/reference_v2.h5 --out reports/campaign`` (:func:`write_design`) writes
 
 * ``design.png``: the cases in the planes (E/σY, K/σY), (E/σY, n), (E/σY, R2/R1),
   (K/σY, n), calibration and validation in different markers, per scene;
@@ -12,15 +12,14 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 from pathlib import Path
 
 import numpy as np
 
-from .campaign import _open_db, _state
 from .design import Case, load_campaign
+from .driver import _open_db, _state
 
 #: (key, label, log axis) of the parameters the design spans
 AXES = (("E_over_sigma_y", "E/σY", True), ("K_over_sigma_y", "K/σY", False), ("n", "n", False),
@@ -126,28 +125,21 @@ def plot(path: Path, cases: list[Case]) -> None:
     plt.close(fig)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--campaign", default="data/campaign_v2.toml")
-    ap.add_argument("--db", default="data/reference_v2.h5")
-    ap.add_argument("--out", default="reports/campaign")
-    args = ap.parse_args(argv)
-    campaign = load_campaign(args.campaign)
+def write_design(campaign_path, db_path, out) -> list[Case]:
+    """Write ``design.md``, ``design.json`` and ``design.png`` of the campaign file ``campaign_path``
+    (the runs' state read from the database at ``db_path``, absent: all missing) into ``out``;
+    returns the campaign's cases."""
+    campaign = load_campaign(campaign_path)
     cases = list(campaign.cases)
-    out = Path(args.out)
+    out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    db = _open_db(Path(args.db))
+    db = _open_db(Path(db_path))
     info = table(cases, db)
     info["points"] = [{"set": c.set, "scene": c.scene, "name": c.name, **point(c)} for c in cases]
     info["replaced"] = [{"set": c.set, "designed": c.replaces[0], "name": c.name, "reason": c.replaces[1],
                          "h_max": c.params["h_max"], "state": _state(db, c.key)}
                         for c in cases if c.replaces]
     (out / "design.json").write_text(json.dumps(info, indent=1, default=float) + "\n")
-    write_markdown(out / "design.md", info, args.campaign)
+    write_markdown(out / "design.md", info, str(campaign_path))
     plot(out / "design.png", cases)
-    print(f"wrote {out}/design.md, design.json, design.png ({len(cases)} cases)")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    return cases

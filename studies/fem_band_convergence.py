@@ -8,7 +8,7 @@ reports F and a read at the increment-wise curve (linear interpolation in ln h, 
 ``make verify-fem``) and read on the local quadratic in ln h through the 11 increments
 nearest to h, which averages the node-closing steps (the FE scatter) out of the comparison;
 the stored curves are not changed. Writes ``band_convergence.json``.
-``python -m spherecontact.fem.band_convergence --out reports/fem [--keep LABEL …]``.
+``python studies/fem_band_convergence.py --out reports/fem [--keep LABEL …]``.
 """
 
 from __future__ import annotations
@@ -21,10 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model.material import Material
-from ..validation.metrics import local_fit_at, scatter
-from .io import run_indentation
-from .solver import SolverOptions
+from spherecontact.fem.io import run_indentation
+from spherecontact.fem.solver import SolverOptions
+from spherecontact.metrics import local_fit_at, scatter
+from spherecontact.model.material import Material
 
 CHECK_H = (0.05, 0.1, 0.3)
 #: label → (edge band, mesh density, solver options); the reference is band 0.03 at density 2

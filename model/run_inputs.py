@@ -1,0 +1,43 @@
+"""Run → model conversion: the closed-form model's material and sphere pair of an FE run's
+stored ``inputs`` (the inverse of ``Material.describe()``), used by the FE, the database, the
+calibration and the validation alike."""
+
+from __future__ import annotations
+
+import math
+
+from .material import Material
+from .sphere import Sphere
+
+__all__ = ["material_from_description", "spheres_from_inputs"]
+
+
+def material_from_description(m: dict) -> Material:
+    """Inverse of ``Material.describe()``: E = inf is rigid; missing plastic keys are elastic."""
+    E, nu = float(m["E"]), float(m.get("nu", 0.3))
+    if math.isinf(E):
+        return Material.rigid(nu)
+    if "eps_table" in m:
+        return Material.from_table(E, nu, m["eps_table"], m["sigma_table"])
+    return Material(E=E, nu=nu, sigma_y=float(m.get("sigma_y", math.inf)), K=float(m.get("K", 0.0)),
+                    n=float(m.get("n", 1.0)))
+
+
+def spheres_from_inputs(inputs: dict, scene: str) -> tuple[Sphere, Sphere]:
+    """The closed-form model's sphere pair of an FE run's ``inputs`` (``Run.inputs``).
+
+    Body 1 is the FE hemisphere (``radius``, ``material``); body 2 the partner of ``scene``:
+    ``"two_body"`` the second deformable sphere (``radius2``, ``material2``; the first's where
+    absent), ``"rigid_sphere"`` a rigid sphere of ``indenter_radius`` (``radius2`` where that
+    is infinite), anything else a rigid flat.
+    """
+    s1 = Sphere(float(inputs["radius"]), material_from_description(inputs["material"]))
+    if scene == "two_body":
+        m2 = inputs.get("material2", inputs["material"])
+        return s1, Sphere(float(inputs.get("radius2", s1.radius)), material_from_description(m2))
+    if scene == "rigid_sphere":
+        R2 = float(inputs.get("indenter_radius", math.inf))
+        if not math.isfinite(R2):
+            R2 = float(inputs["radius2"])
+        return s1, Sphere(R2, Material.rigid())
+    return s1, Sphere(math.inf, Material.rigid())
