@@ -87,11 +87,8 @@ def material_label(m: Material) -> str:
     if math.isinf(m.sigma_y):
         return f"elastic nu={m.nu:g}"
     s = f"E/sy={m.E / m.sigma_y:g} nu={m.nu:g}"
-    if m.is_tabulated:
-        return s + " table"
-    if m.K > 0.0:
-        s += f" K/sy={m.K / m.sigma_y:g} n={m.n:g}"
-    return s
+    hardening = m.flow.label()
+    return f"{s} {hardening}" if hardening else s
 
 
 def resample(h, F, a, lnh_grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -103,9 +103,7 @@ def breakdown(ds: Dataset, coeffs: Coefficients, errors: dict[str, np.ndarray]) 
            "a/R": _bands("a/R", ds.x_R, [0.0, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 1.0], g, eH, ec),
            "h/R": _bands("h/R", ds.h_R, [0.0, 0.003, 0.01, 0.03, 0.1, 0.2, math.inf], g, eH, ec)}
     mats = [c.material for c in ds.curves]
-    hard = np.array(["perfectly plastic" if m.K == 0.0 else
-                     ("table" if m.is_tabulated else f"K/σY={m.K / m.sigma_y:g} n={m.n:g}")
-                     for m in mats])[ds.run]
+    hard = np.array([m.flow.label("σY") or "perfectly plastic" for m in mats])[ds.run]
     out["hardening"] = [_row(h, hard == h, eH, ec) for h in sorted(set(hard))]
     E = np.array([m.E / m.sigma_y for m in mats])[ds.run]
     out["E/σY"] = [_row(f"E/σY = {v:g}", E == v, eH, ec) for v in sorted(set(E))]

@@ -28,7 +28,7 @@ class FlowTables:
         self.last = np.array([len(m.eps_table) - 1 for m in materials])
         self.slope_end = np.empty(len(materials))
         for i, m in enumerate(materials):
-            et, st, sl, self.slope_end[i] = m._table
+            et, st, sl, self.slope_end[i] = m.flow.arrays
             eps[i, :et.size], sig[i, :st.size], slopes[i, :sl.size] = et, st, sl
         self.eps, self.sig, self.slopes = eps.ravel(), sig.ravel(), slopes.ravel()
 

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..model import levels
 from ..model.coefficients import COUNTER_BOUND, LITERATURE, SCHEMA_VERSION, Coefficients, CollapseLimit
+from ..model.flow import Ludwik, Table
 from ..model.single import (
     BodyLaw,
     capped_exponent,
@@ -452,36 +453,42 @@ def _representative_stress(ds: Dataset, beta: float, growth: float, spread: floa
 def _stress_at(ds: Dataset, eps, spread: float, copies: int = 1):
     """σ_rep and m of every point's flow curve at the strains ``eps`` (``copies`` stacked arrays of
     ds.size points each, evaluated in one pass): the Ludwik runs all at once, the tabulated ones
-    run by run."""
+    stacked (``flowtables.FlowTables``), a run of any other law by its own
+    ``FlowCurve.representative``."""
     mats = [c.material for c in ds.curves]
     run = np.tile(ds.run, copies)
-    ludwik = [not m.is_tabulated for m in mats]
+    ludwik = [isinstance(m.flow, Ludwik) for m in mats]
     sy, K, n = (np.asarray(v, dtype=float)[run] for v in zip(
-        *[(m.sigma_y, m.K, m.n) if lu else (1.0, 0.0, 1.0) for m, lu in zip(mats, ludwik, strict=True)],
-        strict=True))
+        *[(m.sigma_y, m.flow.K, m.flow.n) if lu else (1.0, 0.0, 1.0)
+          for m, lu in zip(mats, ludwik, strict=True)], strict=True))
     with np.errstate(invalid="ignore"):
         sig, m = ludwik_representative_stress(sy, K, n, eps, spread)
     m = np.where(np.isfinite(sig), m, 0.0)  # 0 for elastic bodies (σ_Y = inf)
-    if not all(ludwik):
-        table_of_run, tables = _flow_tables(ds)
-        sel = table_of_run[run] >= 0
+    if all(ludwik):
+        return sig, m
+    table_of_run, tables = _flow_tables(ds)
+    sel = table_of_run[run] >= 0
+    if tables is not None:
         rows, e = table_of_run[run[sel]], eps[sel]
         if spread == 0.0:  # representative_stress: σ_f and flow_log_slope
             s, slope = tables.flow(rows, e)
             sig[sel], m[sel] = s, np.maximum(e, 0.0) * slope / s
         else:
             sig[sel], m[sel] = spread_average(lambda x: tables.flow(rows, x), np.maximum(e, 0.0), spread)
+    for i in np.flatnonzero(~np.asarray(ludwik) & (table_of_run < 0)):
+        at = run == i
+        sig[at], m[at] = mats[i].flow.representative(eps[at], spread)
     return sig, m
 
 
-def _flow_tables(ds: Dataset) -> tuple[np.ndarray, FlowTables]:
-    """Each run's row in the stacked tables of the tabulated runs (−1: a Ludwik run) and the
-    tables (``flowtables.FlowTables``), memoised."""
+def _flow_tables(ds: Dataset) -> tuple[np.ndarray, FlowTables | None]:
+    """Each run's row in the stacked tables of the tabulated runs (−1: any other run) and the
+    tables (``flowtables.FlowTables``; None without tabulated runs), memoised."""
     def make():
-        tab = [i for i, c in enumerate(ds.curves) if c.material.is_tabulated]
+        tab = [i for i, c in enumerate(ds.curves) if isinstance(c.material.flow, Table)]
         row = np.full(len(ds.curves), -1)
         row[tab] = np.arange(len(tab))
-        return row, FlowTables([ds.curves[i].material for i in tab])
+        return row, (FlowTables([ds.curves[i].material for i in tab]) if tab else None)
     return _memo(ds, "flow_tables", (), make)
 
 

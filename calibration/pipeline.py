@@ -34,7 +34,7 @@ import numpy as np
 from ..cycles import run_cycles
 from ..fem.increments import read_reruns, smaller_radius
 from ..model.coefficients import Coefficients
-from ..model.single import effective_exponent, hardening_magnitude
+from ..model.single import hardening_magnitude
 from .check import MonotoneCheck, RunError, check_all, run_errors
 from .crossval import DEFAULT_FOLDS, CVResult, FoldSolve, fold_tasks, regime_tasks
 from .dataset import Dataset, build_dataset, quantities
@@ -403,8 +403,7 @@ def calibrated_range(ds: Dataset, coeffs: Coefficients) -> dict:
     """
     mats = [c.material for c in ds.curves]
     plastic = [m for m in mats if math.isfinite(m.sigma_y)]
-    ns = [effective_exponent(m, coeffs) if m.is_tabulated else (m.n if m.K > 0.0 else 0.0)
-          for m in plastic]
+    ns = [m.flow.range_exponent(coeffs.eps_lo, coeffs.eps_hi, coeffs.strain_spread) for m in plastic]
     lam = quantities(ds, coeffs.beta, coeffs.beta_growth, coeffs.strain_spread)["Lambda"]
     lam = lam[np.isfinite(lam) & (lam > 0.0)]
     return {

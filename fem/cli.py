@@ -17,6 +17,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..model.cli_args import (
+    FLOW_HELP,
     material2_from_args,
     material_from_args,
     output_path,
@@ -131,6 +132,7 @@ def _add_material(add) -> None:
         help="tabulated flow curve instead of --sigma-y/--K/--n: two CSV columns eps_p, sigma "
              "(optional header, '#' comments); eps_p starts at 0 and increases strictly, "
              "sigma > 0 non-decreasing; extrapolated with the last slope")
+    add(grp, "--flow", metavar="NAME:P=V,...", default=None, help=FLOW_HELP)
 
 
 def _approach_list(text: str) -> list[float]:
@@ -165,6 +167,8 @@ def _add_geometry(add) -> None:
     add(grp2, "--n2", type=float, default=None, help="Ludwik hardening exponent of body 2, >= 0")
     add(grp2, "--flow-table2", metavar="FILE.csv", default=None,
         help="tabulated flow curve of body 2 instead of --sigma-y2/--K2/--n2 (format of --flow-table)")
+    add(grp2, "--flow2", metavar="NAME:P=V,...", default=None,
+        help="flow curve of body 2 (as --flow; --sigma-y2 defaults to body 1's)")
     add(grp2, "--scene", choices=("auto", "two-body"), default="auto",
         help="auto (default): the cheapest exact scene (rigid partner: one hemisphere on a rigid "
              "flat or sphere; equal bodies: one hemisphere on a flat by symmetry; otherwise two "

@@ -99,72 +99,10 @@ def exp_sym2(e11, e12, e22):
 
 # --------------------------------------------------------------------------- return mapping
 def solve_plastic_multiplier(q_tr, eps_p_n, material: Material, mu: float, tol=1e-12, maxit=100):
-    """Δγ ≥ 0 with q_tr − 3μΔγ − σ_f(ε_p,n + Δγ) = 0, vectorised (bracketed Newton).
-
-    The residual is strictly decreasing in Δγ; the root lies in [0, q_tr/(3μ)].
-    Perfect plasticity has a closed form and Ludwik hardening with n < 1 (slope
-    unbounded at ε_p → 0) is solved in y = ε_p^n (:func:`_multiplier_power`).
-    Here Newton falls back to bisection when it leaves the bracket or stalls
-    (the material's slope is floored at tiny ε_p and one-sided at table kinks);
-    a point is converged where |residual| ≤ tol σ_Y or its bracket has shrunk to
-    the roundoff of ε_p.
-    """
-    q_tr = np.asarray(q_tr, dtype=float)
-    if not material.is_tabulated and material.K == 0.0:
-        return (q_tr - material.sigma_y) / (3.0 * mu)  # perfectly plastic: closed form
-    if not material.is_tabulated and 0.0 < material.n < 1.0:
-        return _multiplier_power(q_tr, np.asarray(eps_p_n, dtype=float), material, mu, tol, maxit)
-    lo = np.zeros_like(q_tr)
-    hi = q_tr / (3.0 * mu)
-    x = np.zeros_like(q_tr)
-    scale = material.sigma_y
-    r_prev = np.full_like(q_tr, np.inf)
-    for _ in range(maxit):
-        r = q_tr - 3.0 * mu * x - material.flow_stress(eps_p_n + x)
-        done = (np.abs(r) <= tol * scale) | (hi - lo <= 4e-16 * (eps_p_n + x) + 1e-30)
-        if np.all(done):
-            break
-        lo = np.where(r > 0, x, lo)
-        hi = np.where(r < 0, x, hi)
-        slope = 3.0 * mu + material.flow_slope(eps_p_n + x)
-        x_new = x + r / slope
-        # bisect when Newton leaves the bracket or stalls (the slope is floored at tiny ε_p)
-        bisect = (x_new <= lo) | (x_new >= hi) | (np.abs(r) > 0.5 * np.abs(r_prev))
-        r_prev = r
-        x = np.where(done, x, np.where(bisect, 0.5 * (lo + hi), x_new))
-    else:
-        raise RuntimeError("return mapping: plastic multiplier did not converge")
-    return x
-
-
-def _multiplier_power(q_tr, eps_p_n, material: Material, mu: float, tol: float, maxit: int):
-    """Ludwik σ_f = σ_Y + K ε_p^n with n < 1: the same root in y = (ε_p,n + Δγ)^n.
-
-    dσ_f/dε_p is unbounded at ε_p → 0, but in y the residual
-    q_tr − 3μ (y^(1/n) − ε_p,n) − σ_Y − K y is smooth with slope −3μ y^(1/n−1)/n − K,
-    so bracketed Newton converges at the onset of yield too. A point is converged where
-    |residual| ≤ tol σ_Y or its bracket has shrunk to the roundoff of y.
-    """
-    n, K, sy = material.n, material.K, material.sigma_y
-    lo = eps_p_n**n
-    hi = (eps_p_n + q_tr / (3.0 * mu)) ** n
-    y = lo.copy()
-    for _ in range(maxit):
-        r = q_tr - 3.0 * mu * (y ** (1.0 / n) - eps_p_n) - sy - K * y
-        # converged, or the bracket has shrunk to the roundoff of y (3μ y^(1/n) cancels ε_p,n:
-        # at E/σY = 1e4 and ε_p ~ 1 its roundoff alone is ~1e-12 σY)
-        done = (np.abs(r) <= tol * sy) | (hi - lo <= 4e-16 * y + 1e-300)
-        if np.all(done):
-            break
-        lo = np.where(r > 0, y, lo)
-        hi = np.where(r < 0, y, hi)
-        slope = 3.0 * mu * y ** (1.0 / n - 1.0) / n + K
-        y_new = y + r / slope
-        bisect = (y_new <= lo) | (y_new >= hi)
-        y = np.where(done, y, np.where(bisect, 0.5 * (lo + hi), y_new))
-    else:
-        raise RuntimeError("return mapping: plastic multiplier did not converge")
-    return np.maximum(y ** (1.0 / n) - eps_p_n, 0.0)
+    """Δγ ≥ 0 with q_tr − 3μΔγ − σ_f(ε_p,n + Δγ) = 0, vectorised: the material's flow curve
+    solves its own scalar equation (``FlowCurve.plastic_multiplier``: bracketed Newton; Ludwik
+    in closed form when perfectly plastic and in y = ε_p^n when n < 1)."""
+    return material.flow.plastic_multiplier(q_tr, eps_p_n, mu, tol, maxit)
 
 
 @dataclass

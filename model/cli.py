@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .cli_args import material2_from_args, material_from_args, output_path
+from .cli_args import FLOW_HELP, material2_from_args, material_from_args, output_path
 from .coefficients import default_coefficients, load_coefficients
 from .contact import contact
 from .cycle import cycle
@@ -222,6 +222,7 @@ def _body_arguments(p) -> None:
     g1.add_argument("--flow-table", metavar="FILE.csv", default=None,
                     help="tabulated flow curve instead of --sigma-y/--K/--n: two CSV columns eps_p, "
                          "sigma (optional header, '#' comments)")
+    g1.add_argument("--flow", metavar="NAME:P=V,...", default=None, help=FLOW_HELP)
     g1.add_argument("--radius", type=float, required=True, help="radius (inf: flat)")
     g2 = p.add_argument_group("body 2 (defaults: same as body 1)")
     g2.add_argument("--E2", type=float)
@@ -230,6 +231,7 @@ def _body_arguments(p) -> None:
     g2.add_argument("--K2", type=float)
     g2.add_argument("--n2", type=float)
     g2.add_argument("--flow-table2", metavar="FILE.csv", help="tabulated flow curve of body 2")
+    g2.add_argument("--flow2", metavar="NAME:P=V,...", help="flow curve of body 2 (as --flow)")
     g2.add_argument("--radius2", type=float)
     p.add_argument("--coefficients", metavar="FILE.json|literature",
                    help="coefficient file (default: the calibrated set shipped with the package); "

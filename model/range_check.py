@@ -41,7 +41,7 @@ import numpy as np
 
 from .calibrated_range import CalibratedRange, CalibrationRangeWarning
 from .coefficients import Coefficients
-from .single import effective_exponent, flow_log_slope, hardening_magnitude, representative_strain
+from .single import flow_log_slope, hardening_magnitude, representative_strain
 from .sphere import Sphere
 
 __all__ = ["RangeCheck", "range_check", "emit"]
@@ -135,7 +135,7 @@ class RangeCheck:
                 continue
             if rng.Lambda is not None:
                 self.limits[f"Lambda_{i}"] = rng.Lambda[1] * SLACK
-            if m.is_tabulated:
+            if m.flow.checks_local_slope:
                 self.limits[f"flow_slope_{i}"] = rng.hardening_n[1] * SLACK
                 self._tables[i] = m
 
@@ -152,12 +152,10 @@ class RangeCheck:
         if math.isinf(m.sigma_y):
             return  # elastic: never leaves Level I
         self._flag(f"E_over_sigma_y_{i}", "E/sigma_y", m.E / m.sigma_y, rng.E_over_sigma_y, who)
-        if m.is_tabulated:
-            n, name = effective_exponent(m, coeffs), "hardening exponent n (secant, flow table)"
-        else:
-            n, name = (m.n if m.K > 0.0 else 0.0), "hardening exponent n"
-        self._flag(f"hardening_n_{i}", name, n, rng.hardening_n, who)
-        name = "hardening magnitude K/sigma_y" + (" (Ludwik fit, flow table)" if m.is_tabulated else "")
+        f = m.flow
+        n = f.range_exponent(coeffs.eps_lo, coeffs.eps_hi, coeffs.strain_spread)
+        self._flag(f"hardening_n_{i}", f.exponent_label.format(kind=f.kind), n, rng.hardening_n, who)
+        name = f.magnitude_label.format(kind=f.kind)
         self._flag(f"K_over_sigma_y_{i}", name, hardening_magnitude(m, coeffs), rng.K_over_sigma_y, who)
 
     def _rigid_partner(self, s1: Sphere, s2: Sphere) -> None:

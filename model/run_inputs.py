@@ -13,14 +13,9 @@ __all__ = ["material_from_description", "spheres_from_inputs"]
 
 
 def material_from_description(m: dict) -> Material:
-    """Inverse of ``Material.describe()``: E = inf is rigid; missing plastic keys are elastic."""
-    E, nu = float(m["E"]), float(m.get("nu", 0.3))
-    if math.isinf(E):
-        return Material.rigid(nu)
-    if "eps_table" in m:
-        return Material.from_table(E, nu, m["eps_table"], m["sigma_table"])
-    return Material(E=E, nu=nu, sigma_y=float(m.get("sigma_y", math.inf)), K=float(m.get("K", 0.0)),
-                    n=float(m.get("n", 1.0)))
+    """Inverse of ``Material.describe()`` (``Material.from_description``): E = inf is rigid;
+    missing plastic keys are elastic."""
+    return Material.from_description(m)
 
 
 def spheres_from_inputs(inputs: dict, scene: str) -> tuple[Sphere, Sphere]:

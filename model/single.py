@@ -50,6 +50,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .coefficients import Coefficients, default_coefficients, exp_poly_log_and_slope
+from .flow.averages import ludwik_representative_stress, spread_average, spread_factors
 from .levels import (
     blend_from_logs,
     blend_pressure,
@@ -91,19 +92,11 @@ _HERTZ = 4.0 / (3.0 * math.pi)
 
 
 def flow_log_slope(material: Material, eps) -> np.ndarray:
-    """m = d ln σ_f / d ln ε_p = ε σ_f'(ε)/σ_f(ε), vectorised (0 at ε = 0 and for elastic bodies).
-
-    Ludwik: m = n K ε^n/(σ_Y + K ε^n); tables: right derivative of the interpolant.
-    """
-    e = np.maximum(np.asarray(eps, dtype=float), 0.0)
-    if material.is_rigid or math.isinf(material.sigma_y):
-        return np.zeros_like(e)
-    if material.is_tabulated:
-        return e * material.flow_slope(e) / material.flow_stress(e)
-    if material.K == 0.0 or material.n == 0.0:
-        return np.zeros_like(e)
-    t = material.K * e**material.n
-    return material.n * t / (material.sigma_y + t)
+    """m = d ln σ_f / d ln ε_p = ε σ_f'(ε)/σ_f(ε), vectorised (0 at ε = 0 and for elastic bodies;
+    ``FlowCurve.log_slope``)."""
+    if material.is_elastic:
+        return np.zeros_like(np.asarray(eps, dtype=float))
+    return material.flow.log_slope(eps)
 
 
 def representative_strain(x, beta: float, growth: float = 0.0):
@@ -116,29 +109,6 @@ def representative_strain(x, beta: float, growth: float = 0.0):
     return beta * x * g1, (1.0 + 2.0 * gx) / g1
 
 
-#: three-point Gauss–Hermite rule of a standard normal variable t: nodes t_j, weights w_j
-_GH_NODES = (0.0, -math.sqrt(3.0), math.sqrt(3.0))
-_GH_WEIGHTS = (2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0)
-
-
-def spread_factors(spread: float) -> tuple[tuple[float, float], ...]:
-    """(e^(W t_j), w_j) of the representative stress's strain distribution, W = ``spread``
-    (one factor 1 with weight 1 for W = 0)."""
-    if spread == 0.0:
-        return ((1.0, 1.0),)
-    return tuple((math.exp(spread * t), w) for t, w in zip(_GH_NODES, _GH_WEIGHTS, strict=True))
-
-
-def ludwik_representative_stress(sigma_y, K, n, eps, spread: float):
-    """:func:`representative_stress` of Ludwik curves σ_Y + K εⁿ (ε σ_f' = n K εⁿ); the
-    parameters may be arrays shaped like ``eps`` (one curve per point, as the calibration has)."""
-    sig = dsig = 0.0
-    for f, w in spread_factors(spread):
-        t = K * (f * eps) ** n
-        sig, dsig = sig + w * (sigma_y + t), dsig + w * n * t
-    return sig, dsig / sig
-
-
 def representative_stress(material: Material, eps, spread: float = 0.0):
     """σ_rep and m = d ln σ_rep/d ln ε_rep at ε_rep (vectorised): the flow curve averaged over a
     log-normal distribution of strains of log-width W = ``spread`` about ε_rep,
@@ -149,33 +119,10 @@ def representative_stress(material: Material, eps, spread: float = 0.0):
     the contact. For a power law σ_f = K εⁿ it is σ_f(ε_rep) times a constant (absorbed by H̄);
     for a curve with a yield plateau, a saturating or a linear one it weighs the strains
     around ε_rep. W = 0: σ_f(ε_rep) and :func:`flow_log_slope`, bit for bit."""
-    if spread == 0.0:
-        return material.flow_stress(eps), flow_log_slope(material, eps)
-    e = np.maximum(np.asarray(eps, dtype=float), 0.0)
-    elastic = material.is_rigid or math.isinf(material.sigma_y)
-    if elastic:
+    if material.is_elastic:
+        e = np.maximum(np.asarray(eps, dtype=float), 0.0)
         return sum(w * material.flow_stress(f * e) for f, w in spread_factors(spread)), np.zeros_like(e)
-    if not material.is_tabulated:
-        return ludwik_representative_stress(material.sigma_y, material.K, material.n, e, spread)
-    return spread_average(lambda x: (material.flow_stress(x), material.flow_slope(x)), e, spread)
-
-
-def spread_average(flow, e, spread: float):
-    """σ_rep and m of :func:`representative_stress` (W = ``spread`` > 0) for a flow curve given
-    by ``flow(ε)`` → (σ_f, σ_f') at the strains ``e`` ≥ 0 (a table's interpolant; one curve, or
-    one per point as ``calibration.flowtables`` evaluates them)."""
-    sig = np.zeros_like(e)
-    dsig = np.zeros_like(e)  # Σ w_j ε_j σ_f'(ε_j) = ε dσ_rep/dε
-    for f, w in spread_factors(spread):
-        ef = f * e
-        s, slope = flow(ef)
-        sig = sig + w * s
-        # flow_log_slope(material, ef) · σ_f, σ_f(ε_f) not evaluated twice (the product kept as
-        # it was written: ε σ_f' alone differs in the last bit, which moves the fitted
-        # coefficients in their 4th digit, calibration/README.md)
-        dsig = dsig + w * (ef * slope / s) * s
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return sig, np.where(sig > 0.0, dsig / sig, 0.0)
+    return material.flow.representative(eps, spread)
 
 
 def curvature_ratio(radius, rho_hertz):
@@ -198,11 +145,9 @@ def effective_exponent(material: Material, coeffs: Coefficients) -> float:
     stays self-similar (Biwa & Storåkers 1995) and F(h) stays smooth. σ_f is the averaged
     curve the representative stress reads (:func:`representative_stress`).
     """
-    if material.is_rigid or math.isinf(material.sigma_y):
+    if material.is_elastic:
         return 0.0
-    s_lo, s_hi = representative_stress(material, np.array([coeffs.eps_lo, coeffs.eps_hi]),
-                                       coeffs.strain_spread)[0]
-    return float(math.log(s_hi / s_lo) / math.log(coeffs.eps_hi / coeffs.eps_lo))
+    return material.flow.secant_exponent(coeffs.eps_lo, coeffs.eps_hi, coeffs.strain_spread)
 
 
 def local_exponent(material: Material, eps, coeffs: Coefficients):
@@ -247,16 +192,9 @@ def hardening_magnitude(material: Material, coeffs: Coefficients) -> float:
     Δσ = σ_f(ε) − σ_f(0): n_L = ln(Δσ(ε_hi)/Δσ(ε_lo))/ln(ε_hi/ε_lo) clipped to [0, 1],
     K = Δσ(ε_hi)/ε_hi^n_L — exact for a tabulated Ludwik curve.
     """
-    if material.is_rigid or math.isinf(material.sigma_y):
+    if material.is_elastic:
         return 0.0
-    if not material.is_tabulated:
-        return material.K / material.sigma_y
-    s0, s_lo, s_hi = material.flow_stress(np.array([0.0, coeffs.eps_lo, coeffs.eps_hi]))
-    d_lo, d_hi = s_lo - s0, s_hi - s0
-    if d_hi <= 0.0:
-        return 0.0
-    n_l = 1.0 if d_lo <= 0.0 else math.log(d_hi / d_lo) / math.log(coeffs.eps_hi / coeffs.eps_lo)
-    return float(d_hi / coeffs.eps_hi ** min(max(n_l, 0.0), 1.0) / s0)
+    return material.flow.hardening_magnitude(coeffs.eps_lo, coeffs.eps_hi)
 
 
 def _segment(material: Material, eps, spread: float = 0.0, window: float = 0.0) -> np.ndarray:
@@ -265,19 +203,14 @@ def _segment(material: Material, eps, spread: float = 0.0, window: float = 0.0) 
     a ``window`` K > 0 (the exponent read along the curve, :func:`local_exponent`) the pieces of
     the strains ε/K and Kε it reads as well, added as a sum: every index grows with ε, so the sum
     changes wherever one of them does and never comes back to a value."""
-    if not material.is_tabulated:
-        return np.zeros(np.shape(eps), dtype=np.int64)
-    et = np.asarray(material.eps_table)
-    eps = np.asarray(eps)
+    flow, eps = material.flow, np.asarray(eps)
     idx = np.zeros(np.shape(eps), dtype=np.int64)
     factors = spread_factors(spread)
     for f, _ in factors:
-        seg = np.clip(np.searchsorted(et, f * eps, side="right") - 1, 0, et.size - 2)
-        idx = idx * (et.size - 1) + seg
+        idx = idx * flow.segments + flow.segment(f * eps)
     if window > 0.0:
-        moved = sum(np.clip(np.searchsorted(et, f * g * eps, side="right") - 1, 0, et.size - 2)
-                    for f, _ in factors for g in (1.0 / window, window))
-        idx = idx + (et.size - 1) ** len(factors) * moved
+        moved = sum(flow.segment(f * g * eps) for f, _ in factors for g in (1.0 / window, window))
+        idx = idx + flow.segments ** len(factors) * moved
     return idx
 
 

@@ -169,13 +169,10 @@ def _sphere_text(i: int, s: Sphere) -> str:
     m = s.material
     if m.is_rigid:
         mat = "rigid"
-    elif m.is_tabulated:
-        mat = f"E = {_num(m.E)}, nu = {_num(m.nu)}, flow table of {len(m.eps_table)} points"
     elif math.isinf(m.sigma_y):
         mat = f"E = {_num(m.E)}, nu = {_num(m.nu)}, elastic"
     else:
-        mat = (f"E = {_num(m.E)}, nu = {_num(m.nu)}, sigma_y = {_num(m.sigma_y)}, K = {_num(m.K)}, "
-               f"n = {_num(m.n)}")
+        mat = f"E = {_num(m.E)}, nu = {_num(m.nu)}, {m.flow.text()}"
     return f"sphere {i}: R = {_num(s.radius)}, {mat}"
 
 

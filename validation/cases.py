@@ -156,11 +156,7 @@ def reference_radius(case: Case) -> float:
 
 
 def _hardens(m: Material) -> bool:
-    if m.is_rigid or math.isinf(m.sigma_y):
-        return False
-    if m.is_tabulated:
-        return m.sigma_table[-1] > m.sigma_table[0]
-    return m.K > 0.0
+    return not m.is_elastic and m.flow.hardens()
 
 
 def is_perfectly_plastic(m: Material) -> bool:

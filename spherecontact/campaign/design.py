@@ -46,6 +46,7 @@ from ..data import input_key
 from ..fem.assembly import ELEMENTS
 from ..fem.mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND_MIN, check_band_floor
 from ..fem.solver import SolverOptions
+from ..model.flow.voce import Voce
 from ..model.material import Material
 from ..model.run_inputs import material_from_description
 
@@ -385,7 +386,8 @@ def _resolve(raw: dict, defaults: dict, where: str, curves: dict | None = None) 
 
 
 def _body1(p: dict, curves: dict) -> Material:
-    """Body 1's material: a named table, Ludwik, or Ludwik plus Voce saturation (tabulated)."""
+    """Body 1's material: a named table, Ludwik, or Ludwik plus Voce saturation
+    (``model.flow.voce``), tabulated at ``VOCE_STRAINS``."""
     sy = p["sigma_y"]
     E = p["E_over_sigma_y"] * sy
     if p.get("flow_curve"):
@@ -395,7 +397,7 @@ def _body1(p: dict, curves: dict) -> Material:
     if p.get("Q_over_sigma_y", 0.0) == 0:
         return lud
     eps = np.array(VOCE_STRAINS)
-    sig = lud.flow_stress(eps) + p["Q_over_sigma_y"] * sy * -np.expm1(-p["b"] * eps)
+    sig = lud.flow_stress(eps) + Voce(sy, p["Q_over_sigma_y"], p["b"]).saturation(eps)
     return Material.from_table(E, p["nu"], eps, _rounded(sig))
 
 
