@@ -13,7 +13,6 @@ import pytest
 from spherecontact.cli import build_parser, join_negative_values, main
 from spherecontact.fem import read_run
 from spherecontact.fem.design import VOCE_STRAINS, _body1
-from spherecontact.model.run_inputs import material_from_description
 from spherecontact.fem.plasticity import solve_plastic_multiplier
 from spherecontact.model import Material, Sphere, contact
 from spherecontact.model.cli_args import material2_from_args, material_from_args
@@ -30,6 +29,7 @@ from spherecontact.model.flow import (
     flow_from_spec,
     register,
 )
+from spherecontact.model.run_inputs import material_from_description
 
 EPS = np.array([1e-4, 3e-3, 0.02, 0.1, 0.4, 1.5])
 
