@@ -188,7 +188,7 @@ LITERATURE: dict = {
             "0 for perfect plasticity."
         ),
         "finite_size": (
-            "DESIGN sec. 2: finite-size and large-deformation terms vanish as a/rho -> 0; none "
+            "docs/design.md §2: finite-size and large-deformation terms vanish as a/rho -> 0; none "
             "in the literature set (pure half-space theory)."
         ),
     },

@@ -10,9 +10,9 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
+from spherecontact.campaign.design import VOCE_STRAINS, _body1
 from spherecontact.cli import build_parser, join_negative_values, main
 from spherecontact.fem import read_run
-from spherecontact.fem.design import VOCE_STRAINS, _body1
 from spherecontact.fem.plasticity import solve_plastic_multiplier
 from spherecontact.model import Material, Sphere, contact
 from spherecontact.model.cli_args import material2_from_args, material_from_args
