@@ -106,7 +106,7 @@ verify-ceiling: $(STAMP)
 
 # the validation's own FE study runs (variants of the standard case) that validate reads
 verify-validation-studies: $(STAMP)
-	$(PY) studies/validation_fem_reports.py --out reports/validation/studies
+	$(PY) studies/validation_fem_reports.py --out data/validation_studies
 
 bench: $(STAMP)
 	$(PY) -m bench.run_all

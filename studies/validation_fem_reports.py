@@ -5,7 +5,7 @@ flat) moves with the FE's mesh density, strain increment, element, approach and 
 (:data:`STUDY_VARIANTS`), i.e. the FE side of the validation report's speed–accuracy chart and
 stability section.
 
-Writes: ``python studies/validation_fem_reports.py --out reports/validation/studies [NAME …]``
+Writes: ``python studies/validation_fem_reports.py --out data/validation_studies [NAME …]``
 runs the missing variants one after another into ``OUT/<name>.json`` (``inputs``, ``curves``,
 ``status``, ``reason``, ``timings``), which ``spherecontact validate`` reads when the database
 holds no ``studies`` set (``spherecontact.validation.study_runs``).
@@ -147,7 +147,7 @@ def run_study_variants(out_dir, names=None) -> list[Path]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="reports/validation/studies")
+    parser.add_argument("--out", default="data/validation_studies")
     parser.add_argument("names", nargs="*", help=f"subset of {', '.join(STUDY_VARIANTS)}")
     args = parser.parse_args(argv)
     run_study_variants(args.out, args.names)

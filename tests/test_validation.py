@@ -362,7 +362,7 @@ def test_report_reads_no_uncommitted_verification_runs_by_default():
     from spherecontact.cli import build_parser
 
     args = build_parser().parse_args(["validate"])
-    assert args.study_runs == "reports/validation/studies" and not hasattr(args, "studies_fallback")
+    assert args.study_runs == "data/validation_studies" and not hasattr(args, "studies_fallback")
     assert args.converged_fe == "data/increments_v2.json"
 
 

@@ -36,7 +36,7 @@ def _validate_parser(cmds) -> None:
     p.add_argument("--converged-fe", default=str(CONVERGED_FE),
                    help="first loadings re-run with increments dh <= r h (spherecontact campaign "
                         "increments; a missing file leaves the section out)")
-    p.add_argument("--study-runs", default="reports/validation/studies",
+    p.add_argument("--study-runs", default="data/validation_studies",
                    help="directory of the validation's own study runs (*.json), read when the database "
                         "has no studies set")
     p.set_defaults(func=validate_command)

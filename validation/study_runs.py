@@ -3,7 +3,7 @@ read them when the database holds no ``studies`` set (the report then names this
 
 Each is a JSON file ``<name>.json`` with ``inputs``, ``curves``, ``status``, ``reason`` and
 ``timings`` (``studies/validation_fem_reports.py`` writes them into
-``reports/validation/studies``: variants of the standard case, E/σ_Y = 200, h/R = 0.3).
+``data/validation_studies``: variants of the standard case, E/σ_Y = 200, h/R = 0.3).
 """
 
 from __future__ import annotations

@@ -5,15 +5,13 @@ spec ``"voce:Q=2,b=10"`` (σ_Y apart) and a description dict (``FlowCurve.descri
 from __future__ import annotations
 
 import math
+from importlib import import_module
 
 from .base import FlowCurve
-from .linear import Linear
 from .ludwik import Ludwik
-from .swift import Swift
 from .table import Table
-from .voce import Voce
 
-__all__ = ["REGISTRY", "register", "flow_from_spec", "flow_from_description"]
+__all__ = ["REGISTRY", "LAWS", "register", "flow_from_spec", "flow_from_description"]
 
 #: registry name → law (a ``FlowCurve`` subclass)
 REGISTRY: dict[str, type[FlowCurve]] = {}
@@ -27,8 +25,22 @@ def register(cls: type[FlowCurve]) -> type[FlowCurve]:
     return cls
 
 
-for _law in (Ludwik, Swift, Voce, Linear, Table):
-    register(_law)
+#: the law modules of this package, each defining one ``FlowCurve`` subclass: adding a law is one
+#: module in ``model/flow/`` and its name here
+LAWS = ("ludwik", "swift", "voce", "linear", "table")
+
+
+def _law_of(module) -> type[FlowCurve]:
+    """The one ``FlowCurve`` subclass a law module defines."""
+    found = [v for v in vars(module).values() if isinstance(v, type) and issubclass(v, FlowCurve)
+             and v.__module__ == module.__name__]
+    if len(found) != 1:
+        raise ImportError(f"{module.__name__} must define exactly one FlowCurve subclass, found {len(found)}")
+    return found[0]
+
+
+for _name in LAWS:
+    register(_law_of(import_module(f".{_name}", __package__)))
 
 
 def _law(name: str, where: str) -> type[FlowCurve]:
