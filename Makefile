@@ -84,14 +84,17 @@ verify-reproduce: $(STAMP)
 verify-pair: $(STAMP)
 	$(PY) studies/fem_verification_pair.py --out reports/fem
 
-# the equal-hardness pairs with the approach-scaled penalty against their stored runs and body 1's flat
+# campaign v1's equal-hardness pairs with the approach-scaled penalty against their stored runs and
+# body 1's flat; they read campaign v1's database, in the git history only:
+#   git show 3667b84:data/reference.h5 > data/reference.h5
 verify-pair-speed: $(STAMP)
-	$(PY) studies/fem_pair_speed.py --out reports/fem
+	$(PY) studies/fem_pair_speed.py --db data/reference.h5 --out reports/fem
 
 # the same pairs as the campaigns run them (surface band 0.03, Gauss-point penalty), each pair and its
 # flat run also alternately twice: the scatter and wall-time targets for two bodies
 verify-pair-speed-band: $(STAMP)
-	$(PY) studies/fem_pair_speed.py --segment-points 3 --edge-band 0.03 --interleave 2 --out reports/fem
+	$(PY) studies/fem_pair_speed.py --db data/reference.h5 --segment-points 3 --edge-band 0.03 \
+		--interleave 2 --out reports/fem
 
 # corner/midside sawtooth of the contact surfaces of every stored two-body run
 verify-pair-surface: $(STAMP)

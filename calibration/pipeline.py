@@ -348,7 +348,7 @@ def replace_first_loading(runs, keys, path) -> tuple[list, list[str]]:
 
 def source_path(db_path) -> str:
     """The database path as the file records it: relative to the working directory when the
-    database lies under it (``data/reference.h5`` whether given as that, ``./data/…`` or
+    database lies under it (``data/reference_v2.h5`` whether given as that, ``./data/…`` or
     absolute), with ``/`` separators; otherwise as given."""
     p = os.path.abspath(os.fspath(db_path))
     try:

@@ -35,7 +35,7 @@ than ``(PROFILE_ROWS - 2) / 6`` cycles keeps every branch change and exceeds the
 Files written before (no ``profiles/increment``) hold every increment and read as
 ``increment = arange(n_inc)``.
 
-Precision, chosen from what takes the space (data/reference.h5: float64 profiles at
+Precision, chosen from what takes the space (campaign v1's database: float64 profiles at
 every increment were ~70 % of 28 MB of data for 35 runs): every curve and ``cycles/*``
 stay float64 (the data calibration and validation fit); the profiles, the Newton residual
 histories, the plastic strain field and the final mesh (``X``, ``u``: pictures; on the

@@ -22,8 +22,9 @@ were recorded do not have them)::
 
 Absent (or ``null``), they take the documented values of the v1 calibration design,
 :data:`DEFAULT_K_OVER_SIGMA_Y` = [0, 2] and :data:`DEFAULT_R_OVER_R_RIGID` = [0, 1] (the
-``[[calibration]]`` entries of ``data/campaign.toml``: K/σ_Y 0 and 2; a rigid flat or a rigid
-sphere of the body's radius), so these axes are checked for older files too.
+``[[calibration]]`` entries of campaign v1, ``studies/campaign_v1.toml``: K/σ_Y 0 and 2; a
+rigid flat or a rigid sphere of the body's radius), so these axes are checked for older files
+too.
 
 A ``null`` entry means the data set recorded none (e.g. no body that yields): ``Lambda``
 is then not checked (small Λ is Level I, exact Hertz, and large Λ is bounded through
@@ -34,7 +35,7 @@ defaults below are used.
 
 Files without the block (the built-in literature set, files written before calibration
 recorded it) get :data:`DEFAULT_RANGE`: the calibration design of the FE campaign
-(``data/campaign.toml``, ``[[calibration]]`` entries: E/σ_Y 10–10000, ν 0.2–0.45,
+(campaign v1, ``studies/campaign_v1.toml``, ``[[calibration]]`` entries: E/σ_Y 10–10000, ν 0.2–0.45,
 Ludwik n 0–0.5 and K/σ_Y 0–2, a rigid flat or a rigid sphere of the body's radius,
 approaches up to h/R = 0.3), a contact radius below the sphere
 radius (a/R < 1) and no Λ limit. Pairs of two deformable spheres: the
@@ -205,7 +206,7 @@ class CalibratedRange:
 
 
 #: Range used when the coefficient set records none: the calibration design of the FE
-#: campaign (data/campaign.toml) — E/σ_Y 10–10000, ν 0.2–0.45, Ludwik n 0–0.5, K/σ_Y 0–2,
+#: campaign v1 (studies/campaign_v1.toml) — E/σ_Y 10–10000, ν 0.2–0.45, Ludwik n 0–0.5, K/σ_Y 0–2,
 #: rigid flat or rigid sphere of radius R, h/R ≤ 0.3 —, a/R < 1 (the contact radius reaching
 #: the sphere radius), no Λ limit, and
 #: the pair ratios of the validation set (radius 4, yield stress 3, Young's modulus 3).

@@ -19,7 +19,7 @@ increment below dh_min) ``stopped``; both live under ``runs/`` and the reader
 returns only converged runs unless asked. A run that raised lives under
 ``failed/``. Read with :class:`Database`, write with :func:`append_run`::
 
-    db = Database("data/reference.h5")
+    db = Database("data/reference_v2.h5")
     for rec, run in db.runs(set="calibration"):
         rec.params["E_over_sigma_y"], run.h, run.F, run.a
 """

@@ -33,7 +33,7 @@ from spherecontact.model.coefficients import Coefficients
 
 __all__ = ["CALIBRATION_CASES", "hertz_result", "model_result", "write_database"]
 
-#: the calibration grid of the campaign (data/campaign.toml), as (case, material, R_i)
+#: the calibration grid of campaign v1 (studies/campaign_v1.toml), as (case, material, R_i)
 CALIBRATION_CASES: list[tuple[str, Material, float]] = (
     [(f"flat-E{E:g}", Material(E=E, nu=0.3, sigma_y=1.0), math.inf)
      for E in (10, 30, 100, 300, 1000, 3000, 10000)]

@@ -17,7 +17,12 @@ the reference contact radius vs Hertz with E*, R* and h₁/h₂ vs E′₂/E′�
 Each pair's record and its flat run's carry the milliseconds per Newton iteration, whole and by
 phase (:func:`~.solver.iteration_split`), which is where a pair's cost against the flat's is read.
 
-``python studies/fem_pair_speed.py --out reports/fem`` → ``approach_pairs.json`` (~4 min);
+The stored pairs are campaign v1's (design ``studies/campaign_v1.toml``); its database is in the
+git history only: ``git show 3667b84:data/reference.h5 > data/reference.h5``, then ``--db
+data/reference.h5``.
+
+``python studies/fem_pair_speed.py --db data/reference.h5 --out reports/fem`` →
+``approach_pairs.json`` (~4 min);
 ``--segment-points 3``: the same with the penalty at 3 Gauss points per edge (two passes, the
 convention of campaign v2's pairs of equal yield stress) → ``approach_pairs_points3.json``. Their
 smooth split differs from the stored nodal runs' by design (fem/README.md, "Contact").
@@ -51,6 +56,8 @@ CASES = ("two-pp-E200-nu0.3-vs-R2", "two-pp-E200-nu0.3-vs-R4", "two-pp-E200-nu0.
 PENALTY = 3000.0
 #: the issue's target: a pair within this many times body 1's run on a flat
 TARGET_RATIO = 3.0
+#: campaign v1's database, retired from the tree: the last commit that has it
+V1_DATABASE = "git show 3667b84:data/reference.h5 > data/reference.h5"
 
 
 def split_difference(stored: dict, new: dict, h_min: float) -> float:
@@ -133,8 +140,10 @@ def hertz_check(penalty: float = PENALTY, segment_points: int = 0) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--db", default="data/reference.h5")
-    ap.add_argument("--campaign", default="data/campaign.toml")
+    ap.add_argument("--db", required=True,
+                    help="campaign v1's database with the stored pairs (data/reference.h5, in the git "
+                         f"history only: {V1_DATABASE})")
+    ap.add_argument("--campaign", default="studies/campaign_v1.toml")
     ap.add_argument("--out", default="reports/fem")
     ap.add_argument("--penalty", type=float, default=PENALTY)
     ap.add_argument("--segment-points", type=int, default=0, choices=range(0, 9), metavar="N",
@@ -159,6 +168,8 @@ def main(argv: list[str] | None = None) -> int:
             check_band_floor(args.band_floor, args.edge_band)
         except ValueError as err:
             ap.error(f"--band-floor: {err}")
+    if not Path(args.db).is_file():
+        ap.error(f"--db {args.db}: no such file (campaign v1's database: {V1_DATABASE})")
     mesh = None if args.edge_band is None else {"edge_band": args.edge_band, "band_floor": args.band_floor}
     db = Database(args.db)
     cases = {c.name: c for c in load_campaign(args.campaign).cases}

@@ -15,8 +15,10 @@ F"; data/README.md, "Surface band of the pairs").
 The bodies' meshes are rebuilt from the run's inputs (gmsh is deterministic) to find the surface
 nodes in the stored final mesh; a run whose stored mesh does not match is reported as such.
 
-``python studies/fem_pair_surface.py --db data/reference_v2.h5 data/reference.h5 --out reports/fem``
-→ ``sawtooth_pairs.json`` (about 10 s for the 16 stored pairs).
+``python studies/fem_pair_surface.py --db data/reference_v2.h5 --out reports/fem``
+→ ``sawtooth_pairs.json`` (about 15 s for campaign v2's 10 pairs). Campaign v1's nodal-penalty
+pairs are in its database, which is in the git history only:
+``git show 3667b84:data/reference.h5 > data/reference.h5``, then ``--db`` it too.
 """
 
 from __future__ import annotations
@@ -89,7 +91,8 @@ def final_surfaces(solver: TwoBodySolver, X: np.ndarray, u: np.ndarray, a_max: f
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--db", nargs="+", default=["data/reference_v2.h5", "data/reference.h5"])
+    ap.add_argument("--db", nargs="+", default=["data/reference_v2.h5"],
+                    help="reference databases whose two-body runs are read (default: campaign v2's)")
     ap.add_argument("--out", default="reports/fem")
     args = ap.parse_args(argv)
     rows = []

@@ -1,6 +1,6 @@
 """Does the current solver reproduce the stored reference curves? (one run per scene)
 
-Re-runs campaign cases of ``data/reference.h5`` with their stored inputs (the solver's
+Re-runs campaign cases of ``data/reference_v2.h5`` with their stored inputs (the solver's
 numerics may have changed since: factorisation, Newton steps) and compares F and a with
 the stored curves at the stored approaches h/R ≥ 0.01 of the loading increments (unloading
 cycles left out; log–log interpolation of the new curve): the systematic difference is the
@@ -10,7 +10,10 @@ to the sum of their scatters.
 
 ``python studies/fem_reproduce.py --out reports/fem`` → ``reproduce.json`` (``--cases``
 re-runs some cases and keeps the others' earlier rows; ``--edge-fit fitted --name F`` re-runs them
-with the contact radius's edge exponent fitted, ``contact.contact_edge``).
+with the contact radius's edge exponent fitted, ``contact.contact_edge``). Campaign v1's cases
+(``flat-pp-E200-nu0.35``, ``rsphere2-pp-E200-nu0.3``, ``two-pp-E200-nu0.3-vs-sy3``): ``--campaign
+studies/campaign_v1.toml --db data/reference.h5 --cases …`` after restoring that database from the
+git history (``git show 3667b84:data/reference.h5 > data/reference.h5``).
 """
 
 from __future__ import annotations
@@ -28,8 +31,8 @@ from spherecontact.fem.contact import EDGE_FITS
 from spherecontact.fem.io import loading_mask, run_indentation
 from spherecontact.metrics import interp_loglog, scatter
 
-#: one case per scene: a flat, a rigid sphere, two bodies (exact contact)
-CASES = ("flat-pp-E200-nu0.35", "rsphere2-pp-E200-nu0.3", "two-pp-E200-nu0.3-vs-sy3")
+#: one validation case of campaign v2 per scene: a flat, a rigid sphere, two bodies (exact contact)
+CASES = ("flat-pp-E250-nu0.3", "rsphere2-pp-E300-nu0.3", "two-pp-E200-nu0.3-vs-sy5")
 
 
 def compare(h_old, y_old, h_new, y_new, h_min: float) -> dict:
@@ -51,8 +54,8 @@ def compare_loading(old: dict, new: dict, h_min: float) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--db", default="data/reference.h5")
-    ap.add_argument("--campaign", default="data/campaign.toml")
+    ap.add_argument("--db", default="data/reference_v2.h5")
+    ap.add_argument("--campaign", default="data/campaign_v2.toml")
     ap.add_argument("--out", default="reports/fem")
     ap.add_argument("--cases", nargs="*", default=list(CASES))
     ap.add_argument("--edge-fit", choices=tuple(EDGE_FITS), default=None,

@@ -126,8 +126,9 @@ def test_defaults_are_checked():
         parse_campaign("[[s]\n")
 
 
-def test_shipped_campaign():
-    c = load_campaign(ROOT / "data" / "campaign.toml")
+def test_campaign_v1_design():
+    """Campaign v1's design (its database retired from the tree) still parses to its 35 cases."""
+    c = load_campaign(ROOT / "studies" / "campaign_v1.toml")
     cal, val = c.select({"calibration"}), c.select({"validation"})
     assert (len(cal), len(val)) == (22, 13)
     assert not {x.key for x in cal} & {x.key for x in val}

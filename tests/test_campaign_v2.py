@@ -127,11 +127,22 @@ def test_a_band_floor_other_than_the_default_names_the_case_and_enters_its_key()
         parse_campaign(pair.replace("edge_band = 0.03", "edge_band = 0") + "band_floor = 0.003\n")
 
 
-def test_v1_campaign_keys_still_match_its_database():
-    db = Database(ROOT / "data" / "reference.h5")
-    cases = load_campaign(ROOT / "data" / "campaign.toml").cases
-    missing = [c.name for c in cases if c.key not in db]
-    assert missing == ["rsphere0.5-K2-n0.4-E600-nu0.3"]  # h_max now of the smaller radius: 0.15
+def test_v2_campaign_keys_match_its_database():
+    """Every case of the shipped v2 design is in the v2 database under its key, name and set, and
+    the database holds nothing else; the designed cases the campaign replaced are not in it."""
+    db = Database(ROOT / "data" / "reference_v2.h5")
+    text = (ROOT / "data" / "campaign_v2.toml").read_text()
+    cases = load_campaign(ROOT / "data" / "campaign_v2.toml").cases
+    records = {rec.key: rec for rec in db.records(status=None)}
+    assert len(cases) == len(records) == 142
+    assert [c.name for c in cases if c.key not in db] == []
+    assert set(records) == {c.key for c in cases}
+    assert all((records[c.key].case, records[c.key].set) == (c.name, c.set) for c in cases)
+    # the design without its [replace] tables: the replaced cases are not in the database
+    designed = parse_campaign(text[:text.index("\n[replace.")]).cases
+    replaced = {c.replaces[0] for c in cases if c.replaces}
+    assert len(replaced) == 3
+    assert sorted(c.name for c in designed if c.key not in db) == sorted(replaced)
 
 
 def test_shipped_v2_design():

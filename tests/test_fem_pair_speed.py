@@ -1,10 +1,15 @@
 """studies/fem_pair_speed.py: the split comparison and the runs it builds from a stored pair."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from fem_pair_speed import CASES, PENALTY, flat_kwargs, pair_kwargs, split_difference
 
 from spherecontact.campaign.design import load_campaign
+
+#: campaign v1's design, whose equal-hardness pairs the study re-runs
+V1 = Path(__file__).resolve().parents[1] / "studies" / "campaign_v1.toml"
 
 
 def _curves(h, split):
@@ -34,7 +39,7 @@ def test_unloading_increments_of_the_stored_run_are_left_out():
 
 
 def test_the_pairs_are_rerun_with_the_approach_scaled_penalty_and_body_1_alone():
-    cases = {c.name: c for c in load_campaign("data/campaign.toml").cases}
+    cases = {c.name: c for c in load_campaign(V1).cases}
     for name in CASES:
         case = cases[name]
         assert case.inputs["material"] == case.inputs["material2"] or case.inputs["radius2"] == 1.0
@@ -56,7 +61,7 @@ def test_iteration_split_reads_the_phases_a_run_timed():
 
 
 def test_a_surface_band_given_applies_to_the_pair_and_its_flat_run_alike():
-    cases = {c.name: c for c in load_campaign("data/campaign.toml").cases}
+    cases = {c.name: c for c in load_campaign(V1).cases}
     case = cases[CASES[2]]
     assert case.run_kwargs()["edge_band"] == 0.0  # campaign v1's pairs: the default mesh
     mesh = {"edge_band": 0.03, "band_floor": 0.003}
@@ -75,8 +80,22 @@ def test_a_bad_band_is_named_before_any_run(args, word, capsys):
     from fem_pair_speed import main
 
     with pytest.raises(SystemExit):
-        main(args)
-    assert word in capsys.readouterr().err
+        main(["--db", "no-such.h5", *args])
+    assert f"error: {word}" in capsys.readouterr().err
+
+
+def test_the_stored_pairs_database_is_asked_for_with_the_way_to_restore_it(tmp_path, capsys):
+    """Campaign v1's database left the tree: --db has no default, and a missing file says where
+    it is."""
+    from fem_pair_speed import main
+
+    with pytest.raises(SystemExit):
+        main([])
+    assert "--db" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["--db", str(tmp_path / "reference.h5")])
+    err = capsys.readouterr().err
+    assert "no such file" in err and "git show 3667b84:data/reference.h5 > data/reference.h5" in err
 
 
 def test_interleaved_rounds_alternate_the_flat_and_the_pair(monkeypatch):
@@ -85,7 +104,7 @@ def test_interleaved_rounds_alternate_the_flat_and_the_pair(monkeypatch):
 
     calls, walls = [], iter([10.0, 30.0, 12.0, 30.0])
     monkeypatch.setattr(pair_speed, "_timed", lambda kw: (calls.append("options" in kw), next(walls)))
-    case = {c.name: c for c in load_campaign("data/campaign.toml").cases}[CASES[0]]
+    case = {c.name: c for c in load_campaign(V1).cases}[CASES[0]]
     out = pair_speed.interleaved(case, 2)
     assert calls == [False, True, False, True]  # flat (no solver options), pair, flat, pair
     assert [r["ratio"] for r in out["rounds"]] == [3.0, 2.5]
