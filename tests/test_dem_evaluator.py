@@ -165,3 +165,38 @@ def test_c_evaluator_ratio_range_and_errors(lib, tmp_path):
     bad = _Table(lib, tmp_path / "noend.sct")
     assert not bad.ptr and "no 'end' line" in bad.err
     assert len(read_table2(tmp_path / "r.sct")["slices"]) == 3
+
+
+class _Stencil(ctypes.Structure):
+    _fields_ = [("n", ctypes.c_int), ("idx", ctypes.c_int * 4), ("w", ctypes.c_double * 4),
+                ("lam", ctypes.c_double * 4), ("log_lam", ctypes.c_double * 4)]
+
+
+def test_c_largest_stiffness_bounds_the_law(lib, tmp_path):
+    """sct_max_stiffness (for a critical time step) is at least every dF/dh of the law up to h_cap,
+    loading or unloading, and sct_h_max is the table's end at the contact's size."""
+    s1, s2 = Sphere(1e-3, STEEL), Sphere(2e-3, ALU)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        law = calibrated_law(s1, s2)
+        write_table2(tmp_path / "t.sct", s1, s2, laws=[law])
+        hm = np.geomspace(1e-4 * law.h_max, law.h_max, 400)
+        rec = law._peaks(hm)[3]
+        h = np.concatenate([hm, hm * (1.0 - rec * 0.5)])
+        k = law.force(h, np.concatenate([hm, hm]))[1]
+    tab = _Table(lib, tmp_path / "t.sct")
+    st = _Stencil()
+    lib.sct_stencil_for.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double,
+                                    ctypes.POINTER(_Stencil), ctypes.c_char_p, ctypes.c_size_t]
+    lib.sct_max_stiffness.argtypes = [ctypes.c_void_p, ctypes.POINTER(_Stencil), ctypes.c_double]
+    lib.sct_max_stiffness.restype = ctypes.c_double
+    lib.sct_h_max.argtypes = [ctypes.c_void_p, ctypes.POINTER(_Stencil)]
+    lib.sct_h_max.restype = ctypes.c_double
+    try:
+        assert lib.sct_stencil_for(tab.ptr, 1e-3, 2e-3, ctypes.byref(st), None, 0) == 0
+        kmax = lib.sct_max_stiffness(tab.ptr, ctypes.byref(st), law.h_max)
+        assert lib.sct_h_max(tab.ptr, ctypes.byref(st)) == law.h_max
+    finally:
+        tab.close()
+    assert kmax >= k.max() * (1.0 - 1e-12)
+    assert kmax <= 1.5 * k.max()  # the bound is the law's, not a loose one
