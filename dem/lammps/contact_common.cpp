@@ -7,7 +7,7 @@
 
 namespace spherecontact_lmp {
 
-// value of "key": in the JSON object that starts at "obj": within meta (strtod reads inf/Infinity)
+// value of "key": in the JSON object that starts at "obj": within meta (a number, or "inf" quoted)
 static bool meta_number(const char *meta, const char *obj, const char *key, double &out)
 {
   const char *o = std::strstr(meta, obj);
@@ -16,7 +16,7 @@ static bool meta_number(const char *meta, const char *obj, const char *key, doub
   const char *k = std::strstr(o, key);
   if (!k || (end && k > end)) return false;
   k += std::strlen(key);
-  while (*k == ' ' || *k == ':') k++;
+  while (*k == ' ' || *k == ':' || *k == '"') k++;
   char *stop = nullptr;
   out = std::strtod(k, &stop);
   return stop != k;
