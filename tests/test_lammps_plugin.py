@@ -370,3 +370,35 @@ def test_one_and_two_mpi_ranks(lammps, tables, tmp_path):
         print(f"1 vs 2 ranks: {loaded} loaded atoms, {moved} crossed between ranks; max force "
               f"difference / max force {f_err:.2g}, torque {t_err:.2g}")
         assert f_err <= MPI_RTOL and t_err <= MPI_RTOL
+
+
+def test_tangential_spring_and_coulomb_limit(lammps, tables):
+    """Steel sphere pressed on the wall (h = 2e-5), then moved along x at 1 mm/s: the tangential
+    force is Mindlin's 8 G* a xi with xi = v t, until it reaches mu F_n and slides."""
+    R, h, v, dt, mu = 1e-3, 2e-5, 1e-3, 1e-8, 0.3
+    law = _law(Sphere(R, STEEL), Sphere(np.inf, WALL))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        st = law(np.array([h]), np.array([h]))
+        Fn = float(law.force(np.array([h]), np.array([h]))[0][0])
+    G = STEEL.E / (2 * (1 + STEEL.nu))
+    kt = 8 * G / (2 - STEEL.nu) * float(st.a[0])  # rigid wall: G* = G/(2 - nu)
+    lmp = _lmp(lammps, _header(1) + f"""create_atoms 1 single 0 0 {R - h!r}
+set atom 1 diameter {2 * R!r} density 7800
+fix w all wall/spherecontact zplane 0 NULL {tables['sw']} friction {mu}
+timestep {dt}
+fix mv all move linear {v} 0.0 0.0
+run 0 post no
+""")
+    out = []
+    for n in (10, 100, 1000, 100000):
+        lmp.command(f"run {n - lmp.get_thermo('step'):.0f} pre no post no")
+        f = lmp.numpy.extract_atom("f")[0]
+        out.append((n, float(f[0]), float(f[2])))
+    lmp.close()
+    for n, fx, fz in out:
+        expect = -min(kt * v * n * dt, mu * Fn)
+        print(f"tangential: {n} steps, F_t {fx:.6g} N, expected {expect:.6g} N (mu F_n {mu * Fn:.6g} N)")
+        assert fz == pytest.approx(Fn, rel=1e-9)
+        assert fx == pytest.approx(expect, rel=1e-9)
+    assert kt * v * out[-2][0] * dt < mu * Fn < kt * v * out[-1][0] * dt  # stuck, then sliding
