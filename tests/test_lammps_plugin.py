@@ -256,6 +256,55 @@ fix w all wall/spherecontact zplane 0 NULL {tables['sw']}
     _check(np.array(F), _reference(lambda h, hm: law.force(h, hm)[0], hs), "steel-wall")
 
 
+def test_moving_wall_variable(lammps, tables):
+    """A HI wall whose position is an equal-style variable (v_ztop) moves down onto a resting steel
+    sphere at 1 m/s, then back up: the force follows the law along h = R - (ztop - z), the fix's
+    vector gives the wall's position, and the wall velocity enters the damping term."""
+    R, dt, v = 1e-3, 1e-8, 1.0
+    law = _law(Sphere(R, STEEL), Sphere(np.inf, WALL))
+    z = 0.0
+    lmp = _lmp(lammps, _header(1) + f"""create_atoms 1 single 0 0 {z!r}
+set atom 1 diameter {2 * R!r} density 7800
+variable z0 equal {R!r}
+variable vel equal {v!r}
+variable ztop equal v_z0-v_vel*time
+fix w all wall/spherecontact zplane NULL v_ztop {tables['sw']}
+timestep {dt!r}
+""")
+    hs, F = [], []
+    for _ in range(30):  # load to 3e-5
+        lmp.command("run 100 post no")
+        zt = float(lmp.extract_variable("ztop"))
+        assert lmp.numpy.extract_fix("w", 0, 1, 3) == pytest.approx(zt, rel=1e-15)
+        hs.append(R - (zt - z))
+        F.append(-float(lmp.numpy.extract_atom("f")[0, 2]))
+        assert lmp.numpy.extract_fix("w", 0, 1, 1) == pytest.approx(F[-1], rel=1e-12)
+    t1 = float(lmp.get_thermo("time"))
+    lmp.command(f"variable z0 equal {float(lmp.extract_variable('ztop'))!r}")
+    lmp.command(f"variable ztop equal v_z0+v_vel*(time-{t1!r})")
+    for _ in range(25):  # unload past separation
+        lmp.command("run 100 post no")
+        hs.append(R - (float(lmp.extract_variable("ztop")) - z))
+        F.append(-float(lmp.numpy.extract_atom("f")[0, 2]))
+    # damping: the wall's velocity (-1 m/s, finite difference of the variable) gives a damped force
+    lmp.command("unfix w")
+    lmp.command(f"variable z0 equal {R - 2e-5!r}")
+    lmp.command(f"variable ztop equal v_z0-v_vel*(time-{float(lmp.get_thermo('time'))!r})")
+    lmp.command(f"fix w2 all wall/spherecontact zplane NULL v_ztop {tables['sw']} damping 0.5")  # new history
+    lmp.command("run 1 post no")
+    Fd = -float(lmp.numpy.extract_atom("f")[0, 2])
+    hd = R - (float(lmp.extract_variable("ztop")) - z)
+    lmp.close()
+    hs, F = np.array(hs), np.array(F)
+    _check(F, _reference(lambda h, hm: law.force(h, hm)[0], hs), "moving wall")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        F0 = law.force(np.array([hd]), np.array([0.0]))[0][0]
+    m = 7800 * 4 / 3 * np.pi * R**3
+    k = (law.force(np.array([hd * (1 + 1e-6)]), np.array([0.0]))[0][0] - F0) / (hd * 1e-6)
+    assert Fd == pytest.approx(F0 + 2 * 0.5 * np.sqrt(m * k) * v, rel=1e-4)
+
+
 ERRORS = {
     "missing table": ("pair_coeff * * {missing}", "cannot open contact table"),
     "corrupt table": ("pair_coeff * * {corrupt}", "corrupt"),

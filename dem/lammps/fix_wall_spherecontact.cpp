@@ -1,9 +1,10 @@
 /* fix wall/spherecontact: see fix_wall_spherecontact.h. For a particle i (body 1) and a wall
  * (body 2, rigid, flat) with n the wall's normal into the box:
- *   overlap h = R_i - (x_i - LO) (LO wall) or R_i - (HI - x_i) (HI wall)
+ *   overlap h = R_i - (x_i - LO) (LO wall) or R_i - (HI - x_i) (HI wall); LO, HI constants or
+ *   equal-style variables (v_name) evaluated every step, the wall velocity v_w = (LO_n - LO_{n-1})/dt
  *   F, dF/dh, a, h1 = sct_eval_stencil(h, h_max) at R1 = R_i, R2 = inf;  h_max <- max(h_max, h)
- *   F_n = max(0, F - 2 gamma sqrt(m_i dF/dh) v_n)                       (Eq. N, m* = m_i)
- *   F_t = -8 G* a xi, |F_t| <= mu F_n, v_t = v_i - v_n n - d_i w_i x n  (Eq. T, d_i = R_i - h1)
+ *   F_n = max(0, F - 2 gamma sqrt(m_i dF/dh) v_n), v = v_i - v_w         (Eq. N, m* = m_i)
+ *   F_t = -8 G* a xi, |F_t| <= mu F_n, v_t = v - v_n n - d_i w_i x n    (Eq. T, d_i = R_i - h1)
  *   force on i: F_n n + F_t; torque -d_i n x F_t */
 #include "fix_wall_spherecontact.h"
 
@@ -12,8 +13,10 @@
 #include "error.h"
 #include "fix_spherecontact_history.h"
 #include "group.h"
+#include "input.h"
 #include "modify.h"
 #include "update.h"
+#include "variable.h"
 
 #include <cmath>
 #include <cstring>
@@ -35,10 +38,19 @@ FixWallSphereContact::FixWallSphereContact(LAMMPS *lmp, int narg, char **arg) :
   else error->all(FLERR, "fix wall/spherecontact: unknown wall {} ({})", dir, usage);
   for (int w = 0; w < 2; w++) {
     has[w] = std::strcmp(arg[4 + w], "NULL") != 0;
-    pos[w] = has[w] ? utils::numeric(FLERR, arg[4 + w], false, lmp) : 0.0;
+    varindex[w] = -1;
+    vwall[w] = prevpos[w] = 0.0;
+    prevset[w] = false;
+    if (has[w] && std::strncmp(arg[4 + w], "v_", 2) == 0) {
+      varname[w] = arg[4 + w] + 2;
+      pos[w] = 0.0;
+    } else {
+      pos[w] = has[w] ? utils::numeric(FLERR, arg[4 + w], false, lmp) : 0.0;
+    }
   }
   if (!has[0] && !has[1]) error->all(FLERR, "fix wall/spherecontact: both walls NULL");
-  if (has[0] && has[1] && pos[0] >= pos[1]) error->all(FLERR, "fix wall/spherecontact: LO >= HI");
+  if (has[0] && has[1] && varname[0].empty() && varname[1].empty() && pos[0] >= pos[1])
+    error->all(FLERR, "fix wall/spherecontact: LO >= HI");
   int iarg = 7;
   std::string files[2] = {arg[6], arg[6]};
   if (iarg < narg && std::strcmp(arg[iarg], "friction") != 0 && std::strcmp(arg[iarg], "damping") != 0)
@@ -65,7 +77,7 @@ FixWallSphereContact::FixWallSphereContact(LAMMPS *lmp, int narg, char **arg) :
                  "line", files[w]);
   }
   vector_flag = 1;
-  size_vector = 2;
+  size_vector = 4;
   global_freq = 1;
   extvector = 1;
   history_id = std::string(id) + "_HISTORY";
@@ -98,6 +110,16 @@ void FixWallSphereContact::init()
     error->all(FLERR, "fix wall/spherecontact with friction requires omega and torque");
   history = static_cast<FixSphereContactHistory *>(modify->get_fix_by_id(history_id));
   if (!history) error->all(FLERR, "fix wall/spherecontact: its history fix {} was deleted", history_id);
+  for (int w = 0; w < 2; w++) {
+    if (varname[w].empty()) continue;
+    varindex[w] = input->variable->find(varname[w].c_str());
+    if (varindex[w] < 0)
+      error->all(FLERR, "fix wall/spherecontact: variable {} for the {} wall does not exist",
+                 varname[w], w ? "HI" : "LO");
+    if (!input->variable->equalstyle(varindex[w]))
+      error->all(FLERR, "fix wall/spherecontact: variable {} is not equal-style", varname[w]);
+    prevset[w] = false;    // the first evaluation of a run gives the wall no velocity
+  }
   // critical time step of the stiffest particle-wall contact: 2 sqrt(m_min / k_max(R_max))
   double rmax = 0.0, mmin = INFINITY, g[2];
   for (int i = 0; i < atom->nlocal; i++)
@@ -135,8 +157,31 @@ void FixWallSphereContact::min_post_force(int vflag)
   post_force(vflag);
 }
 
+// positions of variable walls at this step, and their velocity from the previous evaluation
+void FixWallSphereContact::wall_positions()
+{
+  bool any = false;
+  for (int w = 0; w < 2; w++) {
+    if (varindex[w] < 0) continue;
+    if (!any) modify->clearstep_compute();
+    any = true;
+    pos[w] = input->variable->compute_equal(varindex[w]);
+    vwall[w] = (prevset[w] && !update->setupflag && update->dt > 0.0)
+        ? (pos[w] - prevpos[w]) / update->dt : 0.0;
+    prevpos[w] = pos[w];
+    prevset[w] = true;
+  }
+  if (any) {
+    modify->addstep_compute(update->ntimestep + 1);
+    if (has[0] && has[1] && pos[0] >= pos[1])
+      error->all(FLERR, "fix wall/spherecontact {}: LO {} >= HI {} at step {}", id, pos[0], pos[1],
+                 update->ntimestep);
+  }
+}
+
 void FixWallSphereContact::post_force(int /*vflag*/)
 {
+  wall_positions();
   double **x = atom->x, **v = atom->v, **f = atom->f;
   double **omega = atom->omega, **torque = atom->torque;
   double *radius = atom->radius, *rmass = atom->rmass;
@@ -169,15 +214,18 @@ void FixWallSphereContact::post_force(int /*vflag*/)
       if (res.F > 0.0) {
         double n[3] = {0.0, 0.0, 0.0};
         n[axis] = w == 0 ? 1.0 : -1.0;
-        const double vn = v[i][axis] * n[axis];
+        const double vrel[3] = {v[i][0] - (axis == 0 ? vwall[w] : 0.0),
+                                v[i][1] - (axis == 1 ? vwall[w] : 0.0),
+                                v[i][2] - (axis == 2 ? vwall[w] : 0.0)};
+        const double vn = vrel[axis] * n[axis];
         double fn = damped_normal(res.F, res.dF_dh, vn, rmass[i], gamma), ft[3] = {0.0, 0.0, 0.0};
         const double d = radius[i] - res.h1;
         if (rot) {
           const double *om = omega[i];
           double vt[3];
-          vt[0] = v[i][0] - vn * n[0] - d * (om[1] * n[2] - om[2] * n[1]);
-          vt[1] = v[i][1] - vn * n[1] - d * (om[2] * n[0] - om[0] * n[2]);
-          vt[2] = v[i][2] - vn * n[2] - d * (om[0] * n[1] - om[1] * n[0]);
+          vt[0] = vrel[0] - vn * n[0] - d * (om[1] * n[2] - om[2] * n[1]);
+          vt[1] = vrel[1] - vn * n[1] - d * (om[2] * n[0] - om[0] * n[2]);
+          vt[2] = vrel[2] - vn * n[2] - d * (om[0] * n[1] - om[1] * n[0]);
           tangential(8.0 * law[w].gstar * res.a, mu, fn, n, vt, dt, advance, rec + 1, ft);
           const double nxf[3] = {n[1] * ft[2] - n[2] * ft[1], n[2] * ft[0] - n[0] * ft[2],
                                  n[0] * ft[1] - n[1] * ft[0]};
@@ -199,6 +247,7 @@ void FixWallSphereContact::post_force(int /*vflag*/)
 
 double FixWallSphereContact::compute_vector(int n)
 {
+  if (n >= 2) return has[n - 2] ? pos[n - 2] : 0.0;
   if (!force_flag) {
     MPI_Allreduce(wforce, wforce_all, 2, MPI_DOUBLE, MPI_SUM, world);
     force_flag = 1;
