@@ -14,13 +14,18 @@
 #define NCOL 13 /* node row: ln_h lnF dF_l dF_r lna da_l da_r phi dp_l dp_r recovery m h1_res */
 
 typedef struct {
-    double ratio, R1, R2, Rs, h_elastic, h_min, h_max;
+    double ratio, R1, R2, Rs, log_Rs, h_elastic, h_min, h_max;
     int n;
     double *s, *inv;           /* nodes ln h; 1 / interval width */
     double *cF, *ca, *cp;      /* 4 Hermite coefficients per interval */
     double *rec, *m, *h1r;     /* unloading parameters at the nodes */
     double end[2][7];          /* first / last node: s, lnF, dlnF, lna, dlna, phi, (unused) */
     double *rows;              /* the node rows as read (n x NCOL) */
+    double *blk;               /* per interval, contiguous (one or two cache lines per lookup): */
+                               /* inv, s_j, cF[4], ca[4], cp[4], rec, drec, m, dm, h1r, dh1r */
+    int ng;                    /* lookup grid: ng bins of equal width in ln h over the nodes, */
+    int *grid;                 /* grid[b] = last node j <= n - 2 with s[j] <= the bin's start */
+    double g0, ginv;           /* s of the first node, bins per unit of ln h */
 } sct_slice;
 
 struct sct_table {
@@ -97,6 +102,7 @@ static void hermite(const double *y0, const double *y1, double d0, double d1, do
     c[3] = 2.0 * (*y0 - *y1) + m0 + m1;
 }
 
+#define BLK 20
 static int build_slice(sct_slice *q, char *err, size_t errlen, const char *path, int i) {
     int n = q->n;
     double *r = q->rows;
@@ -144,6 +150,44 @@ static int build_slice(sct_slice *q, char *err, size_t errlen, const char *path,
     memcpy(q->end[0], e0, sizeof e0);
     memcpy(q->end[1], e1, sizeof e1);
     q->Rs = r_star(q->R1, q->R2);
+    q->log_Rs = log(q->Rs);
+    q->blk = malloc(sizeof(double) * BLK * (size_t)n);
+    if (!q->blk) {
+        set_err(err, errlen, "contact table '%s': out of memory", path);
+        return SCT_ERR_IO;
+    }
+    for (int j = 0; j + 1 < n; j++) {
+        double *B = q->blk + (size_t)BLK * j;
+        B[0] = q->inv[j];
+        B[1] = q->s[j];
+        memcpy(B + 2, q->cF + 4 * j, 4 * sizeof(double));
+        memcpy(B + 6, q->ca + 4 * j, 4 * sizeof(double));
+        memcpy(B + 10, q->cp + 4 * j, 4 * sizeof(double));
+        B[14] = q->rec[j];
+        B[15] = q->rec[j + 1] - q->rec[j];
+        B[16] = q->m[j];
+        B[17] = q->m[j + 1] - q->m[j];
+        B[18] = q->h1r[j];
+        B[19] = q->h1r[j + 1] - q->h1r[j];
+    }
+    /* interval lookup in O(1): 4 bins per node on average, then a short forward scan */
+    q->ng = n >= 2 ? 4 * n : 0;
+    q->grid = NULL;
+    if (q->ng) {
+        q->grid = malloc(sizeof(int) * q->ng);
+        if (!q->grid) {
+            set_err(err, errlen, "contact table '%s': out of memory", path);
+            return SCT_ERR_IO;
+        }
+        q->g0 = q->s[0];
+        q->ginv = q->ng / (q->s[n - 1] - q->s[0]);
+        int j = 0;
+        for (int b = 0; b < q->ng; b++) {
+            double sb = q->g0 + b / q->ginv;
+            while (j < n - 2 && q->s[j + 1] <= sb) j++;
+            q->grid[b] = j;
+        }
+    }
     return SCT_OK;
 }
 
@@ -152,7 +196,8 @@ void sct_free(sct_table *t) {
     for (int i = 0; i < t->S; i++) {
         sct_slice *q = &t->sl[i];
         free(q->s); free(q->inv); free(q->cF); free(q->ca); free(q->cp);
-        free(q->rec); free(q->m); free(q->h1r); free(q->rows);
+        free(q->rec); free(q->m); free(q->h1r); free(q->rows); free(q->grid);
+        free(q->blk);
     }
     free(t->sl);
     free(t->x);
@@ -290,6 +335,7 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
     double ratio = isinf(R2) ? INFINITY : R2 / R1;
     double lo = t->sl[0].ratio, hi = t->sl[t->S - 1].ratio;
     double Rs = r_star(R1, R2);
+    /* ln lambda_i = ln R* - ln R*_i: one logarithm per contact, not one per slice */
     if (t->S == 1 || isinf(ratio) || isinf(hi)) {
         int ok = (ratio == lo) || (!isinf(ratio) && !isinf(lo) &&
                                    fabs(log(ratio / lo)) <= SCT_RATIO_TOLERANCE);
@@ -298,7 +344,7 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
         st->idx[0] = 0;
         st->w[0] = 1.0;
         st->lam[0] = Rs / t->sl[0].Rs;
-        st->log_lam[0] = log(st->lam[0]);
+        st->log_lam[0] = log(Rs) - t->sl[0].log_Rs;
         return SCT_OK;
     }
     double x = log(ratio);
@@ -313,6 +359,7 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
     if (i0 > t->S - k) i0 = t->S - k;
     if (i0 < 0) i0 = 0;
     st->n = k;
+    double log_Rs = log(Rs);
     for (int a = 0; a < k; a++) {
         double w = 1.0;
         for (int b = 0; b < k; b++)
@@ -320,7 +367,7 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
         st->idx[a] = i0 + a;
         st->w[a] = w;
         st->lam[a] = Rs / t->sl[i0 + a].Rs;
-        st->log_lam[a] = log(st->lam[a]);
+        st->log_lam[a] = log_Rs - t->sl[i0 + a].log_Rs;
     }
     return SCT_OK;
 outside:
@@ -329,20 +376,23 @@ outside:
     return SCT_ERR_RATIO;
 }
 
+/* the interval j (0 ... n-2) with s[j] <= s < s[j+1], clamped at the ends: the grid's bin gives a
+   node at or below s (bins start at or after their node), then the scan moves up to the last one */
 static int find_interval(const sct_slice *q, double s) {
-    int lo = 0, hi = q->n - 1; /* s[lo] <= s < s[hi] invariant after clamping */
     if (s < q->s[0]) return 0;
     if (s >= q->s[q->n - 1]) return q->n - 2;
-    while (hi - lo > 1) {
-        int mid = (lo + hi) >> 1;
-        if (q->s[mid] <= s) lo = mid; else hi = mid;
-    }
-    return lo;
+    int b = (int)((s - q->g0) * q->ginv);
+    if (b < 0) b = 0;
+    if (b >= q->ng) b = q->ng - 1;
+    int j = q->grid[b];
+    while (j > 0 && q->s[j] > s) j--; /* rounding of the bin's start */
+    while (j < q->n - 2 && q->s[j + 1] <= s) j++;
+    return j;
 }
 
-/* the slice at approach q > 0: ln F, g, ln a, phi, recovery, m, h1_res (FORMAT.md, one slice) */
-static void slice_at(const sct_slice *q, double hq, double *v) {
-    double s = log(hq);
+/* the slice at approach q > 0 (s = ln hq): ln F, g, ln a, phi, recovery, m, h1_res (FORMAT.md,
+   one slice) */
+static void slice_at(const sct_slice *q, double hq, double s, double *v) {
     if (hq < q->h_min || hq > q->h_max) {
         int e = hq > q->h_max;
         const double *E = q->end[e];
@@ -358,18 +408,19 @@ static void slice_at(const sct_slice *q, double hq, double *v) {
         return;
     }
     int j = find_interval(q, s);
-    double inv = q->inv[j];
-    double t = (s - q->s[j]) * inv;
-    const double *c = q->cF + 4 * j;
+    const double *B = q->blk + (size_t)BLK * j;
+    double inv = B[0];
+    double t = (s - B[1]) * inv;
+    const double *c = B + 2;
     v[0] = ((c[3] * t + c[2]) * t + c[1]) * t + c[0];
     v[1] = ((c[3] * (3.0 * t) + 2.0 * c[2]) * t + c[1]) * inv;
-    c = q->ca + 4 * j;
+    c = B + 6;
     v[2] = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
-    c = q->cp + 4 * j;
+    c = B + 10;
     v[3] = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
-    v[4] = q->rec[j] + t * (q->rec[j + 1] - q->rec[j]);
-    v[5] = q->m[j] + t * (q->m[j + 1] - q->m[j]);
-    v[6] = q->h1r[j] + t * (q->h1r[j + 1] - q->h1r[j]);
+    v[4] = B[14] + t * B[15];
+    v[5] = B[16] + t * B[17];
+    v[6] = B[18] + t * B[19];
 }
 
 void sct_eval_stencil(const sct_table *t, const sct_stencil *st, double h, double h_max,
@@ -382,13 +433,14 @@ void sct_eval_stencil(const sct_table *t, const sct_stencil *st, double h, doubl
     out->F = out->dF_dh = out->a = out->h1 = 0.0;
     if (!(q > 0.0)) return;
     double acc[7] = {0, 0, 0, 0, 0, 0, 0}, v[7];
+    double lq = log(q); /* ln(q / lambda_i) = ln q - ln lambda_i */
     if (st->n == 1) {
-        slice_at(&t->sl[st->idx[0]], q / st->lam[0], acc);
+        slice_at(&t->sl[st->idx[0]], q / st->lam[0], lq - st->log_lam[0], acc);
         acc[0] += 2.0 * st->log_lam[0];
         acc[2] += st->log_lam[0];
     } else {
         for (int i = 0; i < st->n; i++) {
-            slice_at(&t->sl[st->idx[i]], q / st->lam[i], v);
+            slice_at(&t->sl[st->idx[i]], q / st->lam[i], lq - st->log_lam[i], v);
             v[0] += 2.0 * st->log_lam[i];
             v[2] += st->log_lam[i];
             for (int c = 0; c < 7; c++) acc[c] += st->w[i] * v[c];

@@ -6,8 +6,8 @@
  * (a table written with --radius2 inf). Same force as pair_style spherecontact (overlap
  * h = R - distance to the plane), the history of each particle-wall contact kept in a fix
  * spherecontact/history "<ID>_HISTORY". LO or HI may be v_name, an equal-style variable evaluated
- * every step (a moving wall, as in fix wall/*); the wall's velocity is the change of the variable
- * over the last step divided by dt. Global vector: the force of the particles on the LO and HI wall
+ * every step (a moving wall, as in LAMMPS' fix wall styles); the wall's velocity is the change of
+ * the variable over the last step divided by dt. Global vector: the force of the particles on the LO and HI wall
  * along the wall normal's axis, then the LO and HI positions (4 values).
  * Documentation: docs/guides/dem-lammps.md. */
 #ifndef SPHERECONTACT_FIX_WALL_H
