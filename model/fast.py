@@ -173,6 +173,11 @@ class ContactLaw:
         the exact solve is used.
     coeffs : coefficient set; default ``model/coefficients.json``.
     rtol : target relative interpolation error of F, a and dF/dh.
+    beyond : ``"exact"`` (default): approaches outside [h_min, h_max] take the exact solve;
+        ``"table"``: they take the table's own explicit rule, the one a DEM code applies to a
+        table file (``dem/FORMAT.md``): ln F and ln a continue linearly in ln h with the end
+        node's one-sided slope, h_1/h and the unloading parameters (recovery, m, h1_res) keep
+        the end node's values (no limit on h; κ and ρ_i there are NaN).
 
     Attributes
     ----------
@@ -204,8 +209,11 @@ class ContactLaw:
 
     def __init__(self, s1: Sphere, s2: Sphere, h_max: float | None = None,
                  h_min: float | None = None, coeffs: Coefficients | None = None,
-                 rtol: float = 1e-6) -> None:
+                 rtol: float = 1e-6, beyond: str = "exact") -> None:
         t0 = time.perf_counter()
+        if beyond not in ("exact", "table"):
+            raise ValueError(f"beyond must be 'exact' or 'table', got {beyond!r}")
+        self.beyond = beyond
         co = default_coefficients() if coeffs is None else coeffs
         self.pair: UnifiedPair = pair(s1, s2, co)
         self._check = range_check(s1, s2, co)
@@ -510,6 +518,13 @@ class ContactLaw:
         plastic = np.flatnonzero(tab["recovery"] < 1.0 - 1e-9)  # the node at Λ_I may be 1 − 1e-12
         first = plastic[0] if plastic.size else s.size
         self._h_elastic = float(np.exp(s[first - 1])) if first > 0 else 0.0
+        # the table's rule beyond its ends (``beyond="table"``): value and one-sided slope of
+        # ln F, ln a at the end nodes (first: right slope, last: left slope), φ and the unloading
+        # parameters there; columns [first node, last node]
+        self._ends_rule = {"s": s[[0, -1]], "lnF": yF[[0, -1]], "dlnF": np.array([dF_r[0], dF_l[-1]]),
+                           "lna": ya[[0, -1]], "dlna": np.array([da_r[0], da_l[-1]]),
+                           "phi": phi[[0, -1]],
+                           **{k: tab[k][[0, -1]] for k in ("recovery", "m", "h1_res")}}
         self._build_lookup()
 
     def _build_lookup(self) -> None:
@@ -696,6 +711,24 @@ class ContactLaw:
         phi = cp[:, 0] + t * (cp[:, 1] + t * (cp[:, 2] + t * cp[:, 3]))
         return F, k, a, phi * h
 
+    def _end_of(self, h):
+        """Index into the end-node columns of ``_ends_rule``: 0 below the table, 1 above it."""
+        return (np.log(h) > self._ends_rule["s"][0]).astype(np.intp)
+
+    def _eval_beyond(self, h, full: bool = False):
+        """The table's rule for h > 0 outside [h_min, h_max] (``beyond="table"``): ln F and ln a
+        linear in s = ln h from the nearer end node with its one-sided slope, φ = h_1/h constant;
+        F and dF/dh = F (d ln F/d ln h)/h (and a, h1 if ``full``)."""
+        e = self._end_of(h)
+        r = self._ends_rule
+        ds = np.log(h) - r["s"][e]
+        F = np.exp(r["lnF"][e] + r["dlnF"][e] * ds)
+        k = F * r["dlnF"][e] / h
+        if not full:
+            return F, k
+        a = np.exp(r["lna"][e] + r["dlna"][e] * ds)
+        return F, k, a, r["phi"][e] * h
+
     def _peaks(self, hm):
         """(F_max, a_max, h1_max, recovery δ_e/h_max, m, h1_res/h_max) of peaks at hm (1-D, > 0):
         the table inside it, the exact state and law outside."""
@@ -713,7 +746,14 @@ class ContactLaw:
                                  for k in ("recovery", "m", "h1_res")]
             for o, v in zip(out, vals, strict=True):
                 o[inside] = v
-        if not inside.all():
+        if not inside.all() and self.beyond == "table":
+            x = hm[~inside]
+            F, _, a, h1 = self._eval_beyond(x, full=True)
+            e = self._end_of(x)
+            vals = [F, a, h1] + [self._ends_rule[k][e] for k in ("recovery", "m", "h1_res")]
+            for o, v in zip(out, vals, strict=True):
+                o[~inside] = v
+        elif not inside.all():
             x = hm[~inside]
             self.pair.check_approach(x, "h_max")
             st = self.pair.state_from_h(x)
@@ -735,6 +775,8 @@ class ContactLaw:
             return None
         low = q < self.h_min                       # h ≤ 0 (no contact) or below the table
         any_low = bool(low.any())
+        if any_low and self.beyond == "table" and bool(np.any(low & (h > 0.0))):
+            return None                            # the table's rule below h_min: the general path
         if any_low:
             q[low] = self.h_min
         s = np.log(q)
@@ -873,7 +915,10 @@ class ContactLaw:
                 F[inside], k[inside] = self._eval(hin)
                 found = self._table_causes(hin)
             out = ~inside & (flat > 0.0)
-            if out.any():
+            if out.any() and self.beyond == "table":
+                F[out], k[out] = self._eval_beyond(flat[out])
+                found = {**self._table_causes(flat[out]), **found}
+            elif out.any():
                 st = self.pair.state_from_h(flat[out])
                 F[out], k[out] = st.F, st.stiffness
                 found = self._exact_causes(st, found)
@@ -904,7 +949,15 @@ class ContactLaw:
             out["p_m"][inside] = F / (math.pi * a * a)
             self._fill_radii(out, inside, a)
         rest = ~inside & (flat > 0.0)
-        if rest.any():
+        if rest.any() and self.beyond == "table":
+            hr = flat[rest]
+            F, k, a, h1 = self._eval_beyond(hr, full=True)
+            out["F"][rest], out["stiffness"][rest], out["a"][rest] = F, k, a
+            out["h1"][rest], out["h2"][rest] = h1, hr - h1
+            out["p_m"][rest] = F / (math.pi * a * a)
+            out["kappa"][rest] = out["rho1"][rest] = out["rho2"][rest] = np.nan
+            found = {**self._table_causes(hr), **found}
+        elif rest.any():
             st = self.pair.state_from_h(flat[rest])
             for f in ("F", "a", "h1", "h2", "stiffness", "p_m", "kappa", "rho1", "rho2"):
                 out[f][rest] = getattr(st, f)
@@ -957,7 +1010,11 @@ class ContactLaw:
         ln F = c₀ + c₁t + c₂t² + c₃t³ on interval j, t = (ln h − ln_h[j])/(ln_h[j+1] − ln_h[j]);
         ``recovery`` and ``m`` (n): δ_e/h_max and the exponent of a peak at each node, linear in
         t; ``h_elastic``: peaks up to it unload along the loading curve; ``h_min``, ``h_max``: the
-        table's range (outside it, the exact solve). For a contact at h with largest approach hm:
+        table's range (outside it, the exact solve, or with ``beyond="table"`` the rule of
+        :meth:`_eval_beyond`). The node values and one-sided slopes (against ln h) the Hermite
+        coefficients are built from: ``ln_F``, ``dln_F_left``, ``dln_F_right``, and the same of
+        ln a (``ln_a``…) and φ = h_1/h (``phi``…); ``h1_res``: body 1's residual approach over
+        h_max of a peak at each node. For a contact at h with largest approach hm:
 
         * loading (h ≥ hm) or elastic peak (hm ≤ h_elastic): q = h, F = exp(ln F(q)),
           dF/dh = F (d ln F/dt)/(q Δ_j), Δ_j = ln_h[j+1] − ln_h[j];
@@ -965,10 +1022,16 @@ class ContactLaw:
           F = exp(ln F(q)) ξ^m, dF/dh = m exp(ln F(q)) ξ^(m−1)/δ_e (0 at ξ = 0);
         * h ≤ 0: F = dF/dh = 0.
         """
+        st = self._node_state
+        (dF_l, da_l, dphi_l), (dF_r, da_r, dphi_r) = self._slopes
         return {"ln_h": self._s.copy(), "ln_F_hermite": self._cF.copy(),
                 "recovery": self.unloading_table["recovery"].copy(),
                 "m": self.unloading_table["m"].copy(), "h_elastic": self._h_elastic,
-                "h_min": self.h_min, "h_max": self.h_max}
+                "h_min": self.h_min, "h_max": self.h_max,
+                "h1_res": self.unloading_table["h1_res"].copy(),
+                "ln_F": np.log(st.F), "dln_F_left": dF_l.copy(), "dln_F_right": dF_r.copy(),
+                "ln_a": np.log(st.a), "dln_a_left": da_l.copy(), "dln_a_right": da_r.copy(),
+                "phi": st.h1 / st.h, "dphi_left": dphi_l.copy(), "dphi_right": dphi_r.copy()}
 
     def describe(self) -> dict:
         """Plain-dict summary: range, node count, measured error bounds, setup time."""

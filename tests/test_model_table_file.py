@@ -77,7 +77,7 @@ def _read_text(path):
 
 
 def test_text_table_holds_the_same_numbers_as_the_npz(tmp_path):
-    assert TABLE_SUFFIXES == (".npz", ".txt")
+    assert TABLE_SUFFIXES == (".sct", ".npz", ".txt")
     s1 = Sphere(1.0, Material(E=500.0, nu=0.3, sigma_y=1.0, K=2.0, n=0.3))
     s2 = Sphere(2.0, Material(E=900.0, nu=0.25, sigma_y=3.0))
     with warnings.catch_warnings():
