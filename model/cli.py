@@ -30,7 +30,7 @@ from .cli_args import FLOW_HELP, material2_from_args, material_from_args, output
 from .coefficients import default_coefficients, load_coefficients
 from .contact import contact
 from .cycle import cycle
-from .dem_table import SLICE_STEP, write_table2
+from .dem_table import SLICE_STEP, strict_json, write_table2
 from .fast import ContactLaw
 from .sphere import Sphere
 
@@ -126,7 +126,7 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
             "nodes": desc["nodes"], "error_bound": desc["error_bound"],
             "calibrated_range_warnings": desc["calibrated_range_warnings"],
             "evaluation": " ".join(ContactLaw.tables.__doc__.split())}
-    meta = _strict_json(meta)
+    meta = strict_json(meta)
     arrays = {k: np.asarray(v, dtype=float) for k, v in tab.items()}
     arrays.update(check_h=check_h, check_h_max=check_hm, check_F=F, check_dF_dh=dF,
                   meta=np.array(json.dumps(meta, allow_nan=False)))
@@ -136,18 +136,6 @@ def write_table(s1: Sphere, s2: Sphere, path, h_max: float | None = None, coeffs
     with open(path, "wb") as fh:  # the name as given (np.savez would append .npz to a bare name)
         np.savez(fh, **arrays)
     return arrays
-
-
-def _strict_json(v):
-    """``v`` with every non-finite float as the string "inf", "-inf" or "nan" (a flat's radius,
-    a rigid body's modulus): standard JSON, which a C or C++ reader parses."""
-    if isinstance(v, dict):
-        return {k: _strict_json(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [_strict_json(x) for x in v]
-    if isinstance(v, float) and not math.isfinite(v):
-        return str(v)
-    return v
 
 
 def _write_text(path, arrays: dict) -> None:

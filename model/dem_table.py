@@ -53,6 +53,18 @@ SLICE_STEP = 2.0 ** 0.25
 CHECKS = 12
 
 
+def strict_json(v):
+    """``v`` with every non-finite float as the string "inf", "-inf" or "nan" (a flat's radius,
+    a rigid body's modulus): standard JSON, which a C or C++ reader parses."""
+    if isinstance(v, dict):
+        return {k: strict_json(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [strict_json(x) for x in v]
+    if isinstance(v, float) and not math.isfinite(v):
+        return str(v)
+    return v
+
+
 def _r_star(R1, R2):
     """Effective radius R* = R_1 R_2/(R_1 + R_2) (R_1 for a flat partner, R_2 = ∞)."""
     R1, R2 = np.asarray(R1, dtype=float), np.asarray(R2, dtype=float)
@@ -122,7 +134,6 @@ def write_table2(path, s1: Sphere, s2: Sphere, ratios=None, h_max: float | None 
     -------
     dict : the file's meta (JSON object of its ``meta`` line).
     """
-    from .cli import _strict_json
 
     if Path(path).suffix != SUFFIX:
         raise ValueError(f"path must end in {SUFFIX}, got {str(path)!r}")
@@ -184,7 +195,7 @@ def write_table2(path, s1: Sphere, s2: Sphere, ratios=None, h_max: float | None 
         checks += ["check " + " ".join(_fmt(v) for v in row)
                    for row in zip(np.full(h.size, R1), np.full(h.size, R2), h, hmax, F, k, a, h1,
                                   strict=True)]
-    meta = _strict_json(meta)
+    meta = strict_json(meta)
     text = "\n".join([FORMAT, "# contact law of a material pair for DEM codes; specification: "
                        "dem/FORMAT.md", f"meta {json.dumps(meta, allow_nan=False)}", *lines,
                        *checks, "end"]) + "\n"
