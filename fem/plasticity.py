@@ -106,6 +106,91 @@ def solve_plastic_multiplier(q_tr, eps_p_n, material: Material, mu: float, tol=1
 
 
 @dataclass
+class J2Return:
+    """Result of :func:`hencky_j2_return`: returned deviator, Kirchhoff stress, Δγ, energy."""
+
+    s_diag: tuple  # returned deviatoric stress, diagonal (or principal) components
+    s_off: tuple  # returned deviatoric stress, off-diagonal components
+    tau_diag: tuple  # Kirchhoff stress τ = K tr ε I + s, diagonal components
+    tau_off: tuple  # Kirchhoff stress, off-diagonal components (= s_off)
+    ev: np.ndarray  # volumetric log strain tr ε^tr (unchanged by the return)
+    dgamma: np.ndarray  # plastic multiplier Δγ (complex-completed for complex input)
+    psi: np.ndarray  # stored Hencky energy per reference volume after the return
+
+
+def hencky_j2_return(e_diag, e_off, eps_p_n, material: Material, dgamma=None, elastic=None
+                     ) -> J2Return:
+    """Hencky elasticity and the J2 radial return on the trial logarithmic strain.
+
+    The part of the exponential-map algorithm (Simo 1992; de Souza Neto et al. 2008,
+    Box 14.3) that does not depend on how ε^tr = ½ ln b_e^tr was obtained; shared by the
+    axisymmetric update (:func:`stress_update`: ε^tr by the 2×2 closed form plus the hoop
+    component) and the 3D one (:mod:`.constitutive3d`: principal values by eigen-decomposition,
+    no off-diagonal components). With ε^tr given by its diagonal components ε_ii and its
+    off-diagonal components ε_ij (i < j, each counted twice in contractions):
+
+        ε_v = Σ ε_ii,   s^tr = 2μ (ε^tr − ε_v/3 I),   q^tr = √(3/2 s^tr : s^tr)
+        Δγ = 0 if q^tr ≤ σ_f(ε_p,n), else q^tr − 3μΔγ − σ_f(ε_p,n + Δγ) = 0
+        s = (1 − 3μΔγ/q^tr) s^tr,   τ = K ε_v I + s,   ψ = s : s/(4μ) + ½ K ε_v²
+
+    (de Souza Neto et al. 2008, Box 7.4, eqs. 7.90–7.93); Δγ from the material's flow curve
+    (``FlowCurve.plastic_multiplier``), any law. For complex ε^tr (complex-step tangent) ``dgamma``
+    must be the real multiplier; it is completed to first order in the imaginary part.
+
+    Parameters
+    ----------
+    e_diag, e_off : sequences of arrays: diagonal and off-diagonal components of ε^tr.
+    eps_p_n : array, equivalent plastic strain at the start of the increment.
+    dgamma : real plastic multiplier, or None to solve for it.
+    elastic : boolean mask of points kept elastic (Δγ = 0), or None.
+    """
+    mu = material.shear_modulus
+    kappa = material.bulk_modulus
+    ev = e_diag[0]
+    for e in e_diag[1:]:
+        ev = ev + e
+    s_diag = [2 * mu * (e - ev / 3) for e in e_diag]
+    s_off = [2 * mu * e for e in e_off]
+
+    def contraction(d, o):  # s : s with off-diagonal pairs counted twice
+        acc = d[0] ** 2
+        for x in d[1:]:
+            acc = acc + x**2
+        for x in o:
+            acc = acc + 2 * x**2
+        return acc
+
+    q_tr = np.sqrt(1.5 * contraction(s_diag, s_off))
+    q_real = np.real(q_tr)
+    if dgamma is None:
+        if np.iscomplexobj(q_tr):
+            raise ValueError("complex F needs the real plastic multiplier dgamma")
+        dgamma = np.zeros_like(q_real)
+        if np.isfinite(material.sigma_y):
+            f_tr = q_real - material.flow_stress(eps_p_n)
+            plastic = f_tr > 0.0
+            if np.any(plastic):
+                dgamma[plastic] = solve_plastic_multiplier(
+                    q_real[plastic], eps_p_n[plastic], material, mu)
+        if elastic is not None:
+            dgamma = np.where(elastic, 0.0, dgamma)
+    plastic = dgamma > 0.0
+    if np.iscomplexobj(q_tr):
+        slope = material.flow_slope(eps_p_n + dgamma) if np.isfinite(material.sigma_y) else 0.0
+        dg = dgamma + np.where(plastic, (q_tr - q_real) / (3 * mu + slope), 0.0)
+    else:
+        dg = dgamma
+    q_safe = np.where(plastic, q_tr, 1.0)
+    factor = np.where(plastic, 1.0 - 3 * mu * dg / q_safe, 1.0)
+    s_diag = tuple(factor * x for x in s_diag)
+    s_off = tuple(factor * x for x in s_off)
+    pk = kappa * ev
+    psi = contraction(s_diag, s_off) / (4 * mu) + 0.5 * kappa * ev**2
+    return J2Return(s_diag=s_diag, s_off=s_off, tau_diag=tuple(pk + x for x in s_diag),
+                    tau_off=s_off, ev=ev, dgamma=dg, psi=psi)
+
+
+@dataclass
 class StressUpdate:
     """Result of one constitutive evaluation (arrays over the points)."""
 
@@ -130,7 +215,6 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None,
     from the real root gives the exact complex-step derivative).
     """
     mu = material.shear_modulus
-    kappa = material.bulk_modulus
     a, b, c, d, ftt = F
     p, q, s, ctt = state_cp_inv
     # trial elastic left Cauchy–Green tensor b_e^tr = F C_p⁻¹ Fᵀ
@@ -145,36 +229,10 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None,
     e11, e12, e22 = log_sym2(b11, b12, b22)
     e11, e12, e22 = 0.5 * e11, 0.5 * e12, 0.5 * e22
     ett = 0.5 * np.log(btt)
-    ev = e11 + e22 + ett
-    s11 = 2 * mu * (e11 - ev / 3)
-    s22 = 2 * mu * (e22 - ev / 3)
-    stt = 2 * mu * (ett - ev / 3)
-    s12 = 2 * mu * e12
-    q_tr = np.sqrt(1.5 * (s11**2 + s22**2 + stt**2 + 2 * s12**2))
-    q_real = np.real(q_tr)
-    if dgamma is None:
-        if np.iscomplexobj(F):
-            raise ValueError("complex F needs the real plastic multiplier dgamma")
-        dgamma = np.zeros_like(q_real)
-        if np.isfinite(material.sigma_y):
-            f_tr = q_real - material.flow_stress(state_eps_p)
-            plastic = f_tr > 0.0
-            if np.any(plastic):
-                dgamma[plastic] = solve_plastic_multiplier(
-                    q_real[plastic], state_eps_p[plastic], material, mu)
-        if elastic is not None:
-            dgamma = np.where(elastic, 0.0, dgamma)
-    plastic = dgamma > 0.0
-    if np.iscomplexobj(q_tr):
-        slope = material.flow_slope(state_eps_p + dgamma) if np.isfinite(material.sigma_y) else 0.0
-        dg = dgamma + np.where(plastic, (q_tr - q_real) / (3 * mu + slope), 0.0)
-    else:
-        dg = dgamma
-    q_safe = np.where(plastic, q_tr, 1.0)
-    factor = np.where(plastic, 1.0 - 3 * mu * dg / q_safe, 1.0)
-    s11, s22, stt, s12 = factor * s11, factor * s22, factor * stt, factor * s12
-    pk = kappa * ev
-    t11, t22, ttt, t12 = pk + s11, pk + s22, pk + stt, s12
+    ret = hencky_j2_return((e11, e22, ett), (e12,), state_eps_p, material, dgamma, elastic)
+    (s11, s22, stt), (s12,) = ret.s_diag, ret.s_off
+    ev, dg = ret.ev, ret.dgamma
+    t11, t22, ttt, t12 = ret.tau_diag + ret.tau_off
     det = a * d - b * c
     i11, i12, i21, i22 = d / det, -b / det, -c / det, a / det  # F⁻¹
     # P = τ F⁻ᵀ, F⁻ᵀ = [[i11, i21], [i12, i22]]
@@ -195,8 +253,7 @@ def stress_update(F, state_cp_inv, state_eps_p, material: Material, dgamma=None,
     k22 = i21 * n12 + i22 * n22
     cp_new = np.stack([k11 * i11 + k12 * i12, k11 * i21 + k12 * i22,
                        k21 * i21 + k22 * i22, ntt / (ftt * ftt)])
-    psi = (s11**2 + s22**2 + stt**2 + 2 * s12**2) / (4 * mu) + 0.5 * kappa * ev**2
-    return StressUpdate(P=P, cp_inv=cp_new, eps_p=state_eps_p + dg, dgamma=dg, psi=psi,
+    return StressUpdate(P=P, cp_inv=cp_new, eps_p=state_eps_p + dg, dgamma=dg, psi=ret.psi,
                         tau=np.stack([t11, t12, t22, ttt]))
 
 
