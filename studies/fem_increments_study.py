@@ -21,23 +21,14 @@ import argparse
 import sys
 from pathlib import Path
 
+from spherecontact.campaign.cli import rerun_arguments
 from spherecontact.campaign.increments import collect, summary_line
-from spherecontact.fem.increments import H_END, RELATIVE_STEP
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--db", default="data/reference_v2.h5")
     ap.add_argument("--out", default="reports/fem")
-    ap.add_argument("--set", default="validation", help="every converged one-body case of this set")
-    ap.add_argument("--cases", nargs="*", default=None, help="these cases instead of --set")
-    ap.add_argument("--relative-step", type=float, default=RELATIVE_STEP,
-                    help=f"increments dh <= this * h (default {RELATIVE_STEP:g}; 0: no such bound)")
-    ap.add_argument("--h-end", type=float, default=H_END,
-                    help=f"approach the re-runs end at, in units of the smaller radius (default {H_END:g})")
-    ap.add_argument("--strain-increment", type=float, default=None,
-                    help="increments dh <= this * a (default: the solver's)")
-    ap.add_argument("--workers", type=int, default=2, help="processes (one case each at a time)")
+    rerun_arguments(ap)
     ap.add_argument("--name", default="increments_validation.json", help="file written in --out")
     args = ap.parse_args(argv)
     try:

@@ -123,10 +123,17 @@ def _increments_parser(cmds) -> None:
                         description="Re-run the first loading of every converged one-body run of a set "
                                     "with increments also bounded by the approach, dh <= r h, and write "
                                     "the curves (JSON).")
+    p.add_argument("--out", default="data/increments_v2.json", help="file to write (JSON)")
+    rerun_arguments(p)
+    p.set_defaults(func=increments_command)
+
+
+def rerun_arguments(p) -> None:
+    """The options of an increment-converged re-run (``--db --set --cases --relative-step --h-end
+    --strain-increment --workers``), shared with ``studies/fem_increments_study.py``."""
     p.add_argument("--db", default="data/reference_v2.h5", help="reference database (HDF5)")
     p.add_argument("--set", default="validation", help="every converged one-body case of this set")
     p.add_argument("--cases", nargs="*", default=None, help="these cases instead of --set")
-    p.add_argument("--out", default="data/increments_v2.json", help="file to write (JSON)")
     p.add_argument("--relative-step", type=float, default=RELATIVE_STEP,
                    help=f"increments dh <= this * h (default {RELATIVE_STEP:g}; 0: no such bound)")
     p.add_argument("--h-end", type=float, default=H_END,
@@ -134,7 +141,6 @@ def _increments_parser(cmds) -> None:
     p.add_argument("--strain-increment", type=float, default=None,
                    help="increments dh <= this * a (default: the solver's)")
     p.add_argument("--workers", type=int, default=2, help="processes (one case each at a time)")
-    p.set_defaults(func=increments_command)
 
 
 def register(subparsers) -> None:
