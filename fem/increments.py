@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..metrics import interp_loglog
-from ..model.run_inputs import material_from_description
+from ..model.material import Material
 from .io import loading_mask, run_indentation
 from .solver import SolverOptions
 
@@ -56,7 +56,7 @@ def rerun(inputs: dict, relative_step: float | None, h_end: float = H_END,
     increments dh ≤ ``relative_step`` · h (None: no such bound) and dh ≤ ``strain_increment`` · a
     (None: the solver's)."""
     strain = {} if strain_increment is None else {"strain_increment": strain_increment}
-    return run_indentation(material_from_description(inputs["material"]), float(inputs["radius"]),
+    return run_indentation(Material.from_description(inputs["material"]), float(inputs["radius"]),
                            h_end * smaller_radius(inputs),
                            indenter_radius=float(inputs.get("indenter_radius", math.inf)),
                            edge_band=float(inputs.get("edge_band", 0.0)),

@@ -69,7 +69,6 @@ import h5py
 import numpy as np
 
 from ..model.material import Material
-from ..model.run_inputs import material_from_description
 from .assembly import ELEMENTS
 from .contact import RigidObstacle
 from .mesh import DENSITY_RANGE, check_band_floor, check_edge_band
@@ -800,10 +799,10 @@ def start_steps(inputs: dict) -> tuple[float, float]:
     stored ``inputs`` (:func:`fem.solver.start_of_loading`)."""
     opts = SolverOptions(**{k: v for k, v in (inputs.get("options") or {}).items()
                             if k in SolverOptions.__dataclass_fields__})
-    m1 = material_from_description(inputs["material"])
+    m1 = Material.from_description(inputs["material"])
     if "radius2" in inputs:  # two bodies
         return start_of_loading(opts, m1, float(inputs["radius"]), float(inputs["radius2"]),
-                                material_from_description(inputs["material2"]))
+                                Material.from_description(inputs["material2"]))
     return start_of_loading(opts, m1, float(inputs["radius"]),
                             float(inputs.get("indenter_radius", math.inf)))
 
@@ -920,12 +919,12 @@ class Run:
 
     def material(self) -> Material:
         """The sphere's material, rebuilt from the stored inputs."""
-        return material_from_description(self.inputs["material"])
+        return Material.from_description(self.inputs["material"])
 
     def material2(self) -> Material | None:
         """Body 2's material (None when the partner was given as a rigid indenter_radius)."""
         m = self.inputs.get("material2")
-        return None if m is None else material_from_description(m)
+        return None if m is None else Material.from_description(m)
 
     @property
     def scene(self) -> str:

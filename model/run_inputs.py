@@ -9,13 +9,7 @@ import math
 from .material import Material
 from .sphere import Sphere
 
-__all__ = ["material_from_description", "spheres_from_inputs"]
-
-
-def material_from_description(m: dict) -> Material:
-    """Inverse of ``Material.describe()`` (``Material.from_description``): E = inf is rigid;
-    missing plastic keys are elastic."""
-    return Material.from_description(m)
+__all__ = ["spheres_from_inputs"]
 
 
 def spheres_from_inputs(inputs: dict, scene: str) -> tuple[Sphere, Sphere]:
@@ -26,10 +20,10 @@ def spheres_from_inputs(inputs: dict, scene: str) -> tuple[Sphere, Sphere]:
     absent), ``"rigid_sphere"`` a rigid sphere of ``indenter_radius`` (``radius2`` where that
     is infinite), anything else a rigid flat.
     """
-    s1 = Sphere(float(inputs["radius"]), material_from_description(inputs["material"]))
+    s1 = Sphere(float(inputs["radius"]), Material.from_description(inputs["material"]))
     if scene == "two_body":
         m2 = inputs.get("material2", inputs["material"])
-        return s1, Sphere(float(inputs.get("radius2", s1.radius)), material_from_description(m2))
+        return s1, Sphere(float(inputs.get("radius2", s1.radius)), Material.from_description(m2))
     if scene == "rigid_sphere":
         R2 = float(inputs.get("indenter_radius", math.inf))
         if not math.isfinite(R2):

@@ -48,7 +48,6 @@ from ..fem.mesh import BAND_FLOOR_RANGE, DENSITY_RANGE, EDGE_BAND_MAX, EDGE_BAND
 from ..fem.solver import SolverOptions
 from ..model.flow.voce import Voce
 from ..model.material import Material
-from ..model.run_inputs import material_from_description
 
 __all__ = ["PARAMETERS", "SCENES", "Param", "Case", "Campaign", "load_campaign", "parse_campaign",
            "run_kwargs"]
@@ -176,13 +175,13 @@ def run_kwargs(inputs: dict, **options) -> dict:
     (:meth:`Case.run_kwargs`) or a stored run's (``Run.inputs``); ``options`` replace recorded
     solver options (e.g. ``max_wall_s``). Two bodies when the inputs name body 2's radius."""
     i = inputs
-    kw = {"material": material_from_description(i["material"]), "radius": i["radius"],
+    kw = {"material": Material.from_description(i["material"]), "radius": i["radius"],
           "h_max": i["h_max"], "density": i["mesh_density"], "element": i["element"],
           "options": SolverOptions(**{**i["options"], **options}),
           "edge_band": i.get("edge_band", 0.0), "band_floor": i.get("band_floor"),
           "unload_at": i.get("unload_at")}
     if "radius2" in i:
-        kw.update(radius2=i["radius2"], material2=material_from_description(i["material2"]))
+        kw.update(radius2=i["radius2"], material2=Material.from_description(i["material2"]))
     else:
         kw["indenter_radius"] = i["indenter_radius"]
     return kw
