@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .fast import ContactLaw
+from .fast import ContactLaw, _hermite
 from .sphere import Sphere
 
 __all__ = ["FORMAT", "SUFFIX", "calibrated_law", "write_table2", "read_table2", "TableLaw",
@@ -261,12 +261,9 @@ def read_table2(path_or_text) -> dict:
 
 
 def _hermite_coeffs(y, d_left, d_right, s):
-    """c0..c3 per interval from node values y and one-sided slopes (the order of operations of
-    ``fast._hermite``, so the doubles are the same)."""
-    ds = np.diff(s)
-    m0, m1 = d_right[:-1] * ds, d_left[1:] * ds
-    y0, y1 = y[:-1], y[1:]
-    return np.stack([y0, m0, 3.0 * (y1 - y0) - 2.0 * m0 - m1, 2.0 * (y0 - y1) + m0 + m1], axis=1)
+    """c0..c3 per interval from node values y and one-sided slopes (``fast._hermite``, so the
+    doubles are the table's own)."""
+    return _hermite(y[:-1], y[1:], d_right[:-1], d_left[1:], np.diff(s))
 
 
 class _Slice:
