@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -16,13 +17,15 @@
 typedef struct {
     double ratio, R1, R2, Rs, log_Rs, h_elastic, h_min, h_max;
     int n;
-    double *s, *inv;           /* nodes ln h; 1 / interval width */
-    double *cF, *ca, *cp;      /* 4 Hermite coefficients per interval */
+    double *s;                 /* nodes ln h */
     double *rec, *m, *h1r;     /* unloading parameters at the nodes */
     double end[2][7];          /* first / last node: s, lnF, dlnF, lna, dlna, phi, (unused) */
     double *rows;              /* the node rows as read (n x NCOL) */
-    double *blk;               /* per interval, contiguous (one or two cache lines per lookup): */
-                               /* inv, s_j, cF[4], ca[4], cp[4], rec, drec, m, dm, h1r, dh1r */
+    /* per interval j, one 64-byte line each (BLK doubles), so that a force needs one line: */
+    double *blkF;              /* s_j, s_j+1, 1/(s_j+1 - s_j), 4 Hermite coefficients of ln F */
+    double *blkA;              /* 4 Hermite coefficients of ln a, 4 of phi */
+    double *blkU;              /* recovery, its increment, m, its increment, h1_res, its increment */
+    double *blk_mem;           /* the allocation holding the three */
     int ng;                    /* lookup grid: ng bins of equal width in ln h over the nodes, */
     int *grid;                 /* grid[b] = last node j <= n - 2 with s[j] <= the bin's start */
     double g0, ginv;           /* s of the first node, bins per unit of ln h */
@@ -31,7 +34,8 @@ typedef struct {
 struct sct_table {
     int S;
     sct_slice *sl;
-    double *x; /* ln ratio of the slices */
+    double *x;    /* ln ratio of the slices */
+    double *wden; /* 1 / prod_{b != a} (x_a - x_b) of stencil i0's slice a: wden[i0 * SCT_ORDER + a] */
     char *meta;
 };
 
@@ -102,19 +106,28 @@ static void hermite(const double *y0, const double *y1, double d0, double d1, do
     c[3] = 2.0 * (*y0 - *y1) + m0 + m1;
 }
 
-#define BLK 20
+#define BLK 8 /* doubles per interval block: one 64-byte cache line */
+
+/* the three block arrays of a slice in one allocation, aligned to 64 bytes (C99: by hand) */
+static int alloc_blocks(sct_slice *q) {
+    size_t len = (size_t)BLK * (size_t)(q->n - 1);
+    q->blk_mem = calloc(3 * len + 8, sizeof(double));
+    if (!q->blk_mem) return 0;
+    uintptr_t p = ((uintptr_t)q->blk_mem + 63) & ~(uintptr_t)63;
+    q->blkF = (double *)p;
+    q->blkA = q->blkF + len;
+    q->blkU = q->blkA + len;
+    return 1;
+}
+
 static int build_slice(sct_slice *q, char *err, size_t errlen, const char *path, int i) {
     int n = q->n;
     double *r = q->rows;
     q->s = malloc(sizeof(double) * n);
-    q->inv = malloc(sizeof(double) * n);
-    q->cF = malloc(sizeof(double) * 4 * n);
-    q->ca = malloc(sizeof(double) * 4 * n);
-    q->cp = malloc(sizeof(double) * 4 * n);
     q->rec = malloc(sizeof(double) * n);
     q->m = malloc(sizeof(double) * n);
     q->h1r = malloc(sizeof(double) * n);
-    if (!q->s || !q->inv || !q->cF || !q->ca || !q->cp || !q->rec || !q->m || !q->h1r) {
+    if (!q->s || !q->rec || !q->m || !q->h1r || !alloc_blocks(q)) {
         set_err(err, errlen, "contact table '%s': out of memory", path);
         return SCT_ERR_IO;
     }
@@ -139,10 +152,20 @@ static int build_slice(sct_slice *q, char *err, size_t errlen, const char *path,
     for (int j = 0; j + 1 < n; j++) {
         const double *a = r + (size_t)j * NCOL, *b = a + NCOL;
         double ds = b[0] - a[0];
-        q->inv[j] = 1.0 / ds;
-        hermite(&a[1], &b[1], a[3], b[2], ds, q->cF + 4 * j);
-        hermite(&a[4], &b[4], a[6], b[5], ds, q->ca + 4 * j);
-        hermite(&a[7], &b[7], a[9], b[8], ds, q->cp + 4 * j);
+        double *F = q->blkF + (size_t)BLK * j, *A = q->blkA + (size_t)BLK * j;
+        double *U = q->blkU + (size_t)BLK * j;
+        F[0] = a[0];
+        F[1] = b[0];
+        F[2] = 1.0 / ds;
+        hermite(&a[1], &b[1], a[3], b[2], ds, F + 3);
+        hermite(&a[4], &b[4], a[6], b[5], ds, A);
+        hermite(&a[7], &b[7], a[9], b[8], ds, A + 4);
+        U[0] = a[10];
+        U[1] = b[10] - a[10];
+        U[2] = a[11];
+        U[3] = b[11] - a[11];
+        U[4] = a[12];
+        U[5] = b[12] - a[12];
     }
     const double *f = r, *l = r + (size_t)(n - 1) * NCOL;
     double e0[7] = {f[0], f[1], f[3], f[4], f[6], f[7], 0.0};
@@ -151,25 +174,6 @@ static int build_slice(sct_slice *q, char *err, size_t errlen, const char *path,
     memcpy(q->end[1], e1, sizeof e1);
     q->Rs = r_star(q->R1, q->R2);
     q->log_Rs = log(q->Rs);
-    q->blk = malloc(sizeof(double) * BLK * (size_t)n);
-    if (!q->blk) {
-        set_err(err, errlen, "contact table '%s': out of memory", path);
-        return SCT_ERR_IO;
-    }
-    for (int j = 0; j + 1 < n; j++) {
-        double *B = q->blk + (size_t)BLK * j;
-        B[0] = q->inv[j];
-        B[1] = q->s[j];
-        memcpy(B + 2, q->cF + 4 * j, 4 * sizeof(double));
-        memcpy(B + 6, q->ca + 4 * j, 4 * sizeof(double));
-        memcpy(B + 10, q->cp + 4 * j, 4 * sizeof(double));
-        B[14] = q->rec[j];
-        B[15] = q->rec[j + 1] - q->rec[j];
-        B[16] = q->m[j];
-        B[17] = q->m[j + 1] - q->m[j];
-        B[18] = q->h1r[j];
-        B[19] = q->h1r[j + 1] - q->h1r[j];
-    }
     /* interval lookup in O(1): 4 bins per node on average, then a short forward scan */
     q->ng = n >= 2 ? 4 * n : 0;
     q->grid = NULL;
@@ -195,12 +199,12 @@ void sct_free(sct_table *t) {
     if (!t) return;
     for (int i = 0; i < t->S; i++) {
         sct_slice *q = &t->sl[i];
-        free(q->s); free(q->inv); free(q->cF); free(q->ca); free(q->cp);
-        free(q->rec); free(q->m); free(q->h1r); free(q->rows); free(q->grid);
-        free(q->blk);
+        free(q->s); free(q->rec); free(q->m); free(q->h1r); free(q->rows); free(q->grid);
+        free(q->blk_mem);
     }
     free(t->sl);
     free(t->x);
+    free(t->wden);
     free(t->meta);
     free(t);
 }
@@ -308,6 +312,18 @@ sct_table *sct_load(const char *path, char *err, size_t errlen) {
         set_err(err, errlen, "contact table '%s' is corrupt: a flat (ratio inf) in a ratio range", path);
         goto fail;
     }
+    if (t->S > 1) { /* Lagrange denominators of every stencil (FORMAT.md, contact step 1) */
+        int k = t->S < SCT_ORDER ? t->S : SCT_ORDER;
+        t->wden = calloc((size_t)t->S * SCT_ORDER, sizeof(double));
+        if (!t->wden) goto oom;
+        for (int i0 = 0; i0 + k <= t->S; i0++)
+            for (int a = 0; a < k; a++) {
+                double d = 1.0;
+                for (int b = 0; b < k; b++)
+                    if (b != a) d *= t->x[i0 + a] - t->x[i0 + b];
+                t->wden[i0 * SCT_ORDER + a] = 1.0 / d;
+            }
+    }
     if (!t->meta) {
         t->meta = calloc(1, 1);
         if (!t->meta) goto oom;
@@ -335,7 +351,6 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
     double ratio = isinf(R2) ? INFINITY : R2 / R1;
     double lo = t->sl[0].ratio, hi = t->sl[t->S - 1].ratio;
     double Rs = r_star(R1, R2);
-    /* ln lambda_i = ln R* - ln R*_i: one logarithm per contact, not one per slice */
     if (t->S == 1 || isinf(ratio) || isinf(hi)) {
         int ok = (ratio == lo) || (!isinf(ratio) && !isinf(lo) &&
                                    fabs(log(ratio / lo)) <= SCT_RATIO_TOLERANCE);
@@ -344,7 +359,7 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
         st->idx[0] = 0;
         st->w[0] = 1.0;
         st->lam[0] = Rs / t->sl[0].Rs;
-        st->log_lam[0] = log(Rs) - t->sl[0].log_Rs;
+        st->Rs = Rs;
         return SCT_OK;
     }
     double x = log(ratio);
@@ -359,15 +374,16 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
     if (i0 > t->S - k) i0 = t->S - k;
     if (i0 < 0) i0 = 0;
     st->n = k;
-    double log_Rs = log(Rs);
+    st->Rs = Rs;
+    double d[SCT_ORDER];
+    for (int a = 0; a < k; a++) d[a] = x - t->x[i0 + a];
     for (int a = 0; a < k; a++) {
-        double w = 1.0;
+        double w = t->wden[i0 * SCT_ORDER + a];
         for (int b = 0; b < k; b++)
-            if (b != a) w *= (x - t->x[i0 + b]) / (t->x[i0 + a] - t->x[i0 + b]);
+            if (b != a) w *= d[b];
         st->idx[a] = i0 + a;
         st->w[a] = w;
         st->lam[a] = Rs / t->sl[i0 + a].Rs;
-        st->log_lam[a] = log_Rs - t->sl[i0 + a].log_Rs;
     }
     return SCT_OK;
 outside:
@@ -376,78 +392,111 @@ outside:
     return SCT_ERR_RATIO;
 }
 
-/* the interval j (0 ... n-2) with s[j] <= s < s[j+1], clamped at the ends: the grid's bin gives a
-   node at or below s (bins start at or after their node), then the scan moves up to the last one */
-static int find_interval(const sct_slice *q, double s) {
-    if (s < q->s[0]) return 0;
-    if (s >= q->s[q->n - 1]) return q->n - 2;
-    int b = (int)((s - q->g0) * q->ginv);
-    if (b < 0) b = 0;
-    if (b >= q->ng) b = q->ng - 1;
-    int j = q->grid[b];
-    while (j > 0 && q->s[j] > s) j--; /* rounding of the bin's start */
-    while (j < q->n - 2 && q->s[j + 1] <= s) j++;
+/* parts of a slice's values (FORMAT.md, one slice): v = ln F, g, ln a, phi, recovery, m, h1_res */
+#define PART_A 1      /* ln a */
+#define PART_PHI 2    /* phi */
+#define PART_UNLOAD 4 /* recovery, m */
+#define PART_H1RES 8  /* h1_res */
+
+/* the end node's rule beyond the table (s below the first node or above the last) */
+static void slice_beyond(const sct_slice *q, double s, int parts, double *v) {
+    int e = s > q->end[1][0];
+    const double *E = q->end[e];
+    int node = e ? q->n - 1 : 0;
+    double ds = s - E[0];
+    v[0] = E[1] + E[2] * ds;
+    v[1] = E[2];
+    if (parts & PART_A) v[2] = E[3] + E[4] * ds;
+    if (parts & PART_PHI) v[3] = E[5];
+    if (parts & PART_UNLOAD) {
+        v[4] = q->rec[node];
+        v[5] = q->m[node];
+    }
+    if (parts & PART_H1RES) v[6] = q->h1r[node];
+}
+
+/* the interval j (0 ... n-2) of s inside the table, s_j <= s < s_j+1 (s_n-1 itself: the last):
+   from the grid's node j_b one step either way without a branch (a bin rarely holds two node
+   boundaries, then the scan) */
+static inline int interval_of(const sct_slice *q, double s, int jb) {
+    const double *F = q->blkF + (size_t)BLK * jb;
+    int j = jb + (s >= F[1]) - (s < F[0]);
+    if (j > q->n - 2) j = q->n - 2;
+    F = q->blkF + (size_t)BLK * j;
+    if (F[0] <= s && (s < F[1] || j == q->n - 2)) return j;
+    while (j > 0 && F[0] > s) { j--; F -= BLK; }
+    while (j < q->n - 2 && F[1] <= s) { j++; F += BLK; }
     return j;
 }
 
-/* the slice at approach q > 0 (s = ln hq): ln F, g, ln a, phi, recovery, m, h1_res (FORMAT.md,
-   one slice) */
-static void slice_at(const sct_slice *q, double hq, double s, double *v) {
-    if (hq < q->h_min || hq > q->h_max) {
-        int e = hq > q->h_max;
-        const double *E = q->end[e];
-        int node = e ? q->n - 1 : 0;
-        double ds = s - E[0];
-        v[0] = E[1] + E[2] * ds;
-        v[1] = E[2];
-        v[2] = E[3] + E[4] * ds;
-        v[3] = E[5];
-        v[4] = q->rec[node];
-        v[5] = q->m[node];
-        v[6] = q->h1r[node];
-        return;
-    }
-    int j = find_interval(q, s);
-    const double *B = q->blk + (size_t)BLK * j;
-    double inv = B[0];
-    double t = (s - B[1]) * inv;
-    const double *c = B + 2;
+/* the slice's values in interval j at s (FORMAT.md, one slice, step 1) */
+static inline void slice_in(const sct_slice *q, int j, double s, int parts, double *v) {
+    const double *F = q->blkF + (size_t)BLK * j;
+    double inv = F[2];
+    double t = (s - F[0]) * inv;
+    const double *c = F + 3;
     v[0] = ((c[3] * t + c[2]) * t + c[1]) * t + c[0];
     v[1] = ((c[3] * (3.0 * t) + 2.0 * c[2]) * t + c[1]) * inv;
-    c = B + 6;
-    v[2] = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
-    c = B + 10;
-    v[3] = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
-    v[4] = B[14] + t * B[15];
-    v[5] = B[16] + t * B[17];
-    v[6] = B[18] + t * B[19];
+    if (parts & (PART_A | PART_PHI)) {
+        const double *A = q->blkA + (size_t)BLK * j;
+        if (parts & PART_A) v[2] = A[0] + t * (A[1] + t * (A[2] + t * A[3]));
+        if (parts & PART_PHI) v[3] = A[4] + t * (A[5] + t * (A[6] + t * A[7]));
+    }
+    if (parts & (PART_UNLOAD | PART_H1RES)) {
+        const double *U = q->blkU + (size_t)BLK * j;
+        if (parts & PART_UNLOAD) {
+            v[4] = U[0] + t * U[1];
+            v[5] = U[2] + t * U[3];
+        }
+        if (parts & PART_H1RES) v[6] = U[4] + t * U[5];
+    }
 }
 
-void sct_eval_stencil(const sct_table *t, const sct_stencil *st, double h, double h_max,
-                      sct_result *out) {
+void sct_eval_parts(const sct_table *t, const sct_stencil *st, double h, double h_max, int want,
+                    sct_result *out) {
     int elastic = 1;
     for (int i = 0; i < st->n; i++)
-        if (!(h_max / st->lam[i] <= t->sl[st->idx[i]].h_elastic)) { elastic = 0; break; }
+        if (!(h_max <= t->sl[st->idx[i]].h_elastic * st->lam[i])) { elastic = 0; break; }
     int loading = (h >= h_max) || elastic;
     double q = loading ? h : h_max;
     out->F = out->dF_dh = out->a = out->h1 = 0.0;
     if (!(q > 0.0)) return;
-    double acc[7] = {0, 0, 0, 0, 0, 0, 0}, v[7];
-    double lq = log(q); /* ln(q / lambda_i) = ln q - ln lambda_i */
-    if (st->n == 1) {
-        slice_at(&t->sl[st->idx[0]], q / st->lam[0], lq - st->log_lam[0], acc);
-        acc[0] += 2.0 * st->log_lam[0];
-        acc[2] += st->log_lam[0];
-    } else {
-        for (int i = 0; i < st->n; i++) {
-            slice_at(&t->sl[st->idx[i]], q / st->lam[i], lq - st->log_lam[i], v);
-            v[0] += 2.0 * st->log_lam[i];
-            v[2] += st->log_lam[i];
-            for (int c = 0; c < 7; c++) acc[c] += st->w[i] * v[c];
+    int parts = ((want & SCT_WANT_A) ? PART_A : 0) | ((want & SCT_WANT_H1) ? PART_PHI : 0);
+    if (!loading) parts |= PART_UNLOAD | ((want & SCT_WANT_H1) ? PART_H1RES : 0);
+    double acc[7] = {0, 0, 0, 0, 0, 0, 0}, v[7] = {0, 0, 0, 0, 0, 0, 0};
+    /* slice i at q / lambda_i, lambda_i = R* / R*_i: s_i = ln(q / R*) + ln R*_i; one logarithm */
+    double lq = log(q / st->Rs);
+    /* the slices' lookups first, one pass each, so that their memory loads overlap */
+    const sct_slice *sl[SCT_ORDER];
+    double si[SCT_ORDER];
+    int ji[SCT_ORDER];
+    for (int i = 0; i < st->n; i++) {
+        const sct_slice *q = sl[i] = &t->sl[st->idx[i]];
+        si[i] = lq + q->log_Rs;
+        ji[i] = -1; /* beyond the table */
+        if (si[i] >= q->end[0][0] && si[i] <= q->end[1][0]) {
+            int b = (int)((si[i] - q->g0) * q->ginv);
+            b = b < 0 ? 0 : (b >= q->ng ? q->ng - 1 : b);
+            ji[i] = q->grid[b];
         }
     }
-    double Fq = exp(acc[0]);
-    double aq = exp(acc[2]);
+    for (int i = 0; i < st->n; i++)
+        if (ji[i] >= 0) ji[i] = interval_of(sl[i], si[i], ji[i]);
+    for (int i = 0; i < st->n; i++) {
+        if (ji[i] >= 0)
+            slice_in(sl[i], ji[i], si[i], parts, v);
+        else
+            slice_beyond(sl[i], si[i], parts, v);
+        double w = st->w[i];
+        /* ln F = sum w_i (ln F_i + 2 ln lambda_i) = 2 ln R* + sum w_i (ln F_i - 2 ln R*_i), as
+           the weights sum to 1; ln a likewise with ln R* */
+        acc[0] += w * (v[0] - 2.0 * sl[i]->log_Rs);
+        acc[1] += w * v[1];
+        acc[2] += w * (v[2] - sl[i]->log_Rs);
+        for (int c = 3; c < 7; c++) acc[c] += w * v[c];
+    }
+    double Fq = st->Rs * st->Rs * exp(acc[0]);
+    double aq = (want & SCT_WANT_A) ? st->Rs * exp(acc[2]) : 0.0;
     if (loading) {
         out->F = Fq;
         out->dF_dh = Fq * acc[1] / q;
@@ -465,6 +514,11 @@ void sct_eval_stencil(const sct_table *t, const sct_stencil *st, double h, doubl
     out->a = aq * xm1;
     double h1res = acc[6] * q;
     out->h1 = h1res + xi * (acc[3] * q - h1res);
+}
+
+void sct_eval_stencil(const sct_table *t, const sct_stencil *st, double h, double h_max,
+                      sct_result *out) {
+    sct_eval_parts(t, st, h, h_max, SCT_WANT_ALL, out);
 }
 
 int sct_eval(const sct_table *t, double R1, double R2, double h, double h_max, sct_result *out) {

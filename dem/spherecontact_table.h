@@ -52,7 +52,7 @@ typedef struct {
     int idx[SCT_ORDER];       /* their indices */
     double w[SCT_ORDER];      /* Lagrange weights in ln(R2/R1) */
     double lam[SCT_ORDER];    /* size factors R* / R*_i */
-    double log_lam[SCT_ORDER];
+    double Rs;                /* the contact's R* = R1 R2 / (R1 + R2) (R1 on a flat) */
 } sct_stencil;
 
 /* Load a table; NULL on failure with the reason (naming the file and the problem) in err. */
@@ -67,6 +67,14 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
 /* Evaluate the law at approach h with history h_max (the largest approach reached before). */
 void sct_eval_stencil(const sct_table *t, const sct_stencil *st, double h, double h_max,
                       sct_result *out);
+
+/* The same, computing only the parts a caller needs: F and dF/dh always, a with SCT_WANT_A, h1
+   with SCT_WANT_H1 (a part not asked for is 0 in out). */
+#define SCT_WANT_A 1
+#define SCT_WANT_H1 2
+#define SCT_WANT_ALL (SCT_WANT_A | SCT_WANT_H1)
+void sct_eval_parts(const sct_table *t, const sct_stencil *st, double h, double h_max, int want,
+                    sct_result *out);
 
 /* Both steps for one contact; returns SCT_OK or SCT_ERR_RATIO / SCT_ERR_ARG. */
 int sct_eval(const sct_table *t, double R1, double R2, double h, double h_max, sct_result *out);

@@ -169,7 +169,7 @@ def test_c_evaluator_ratio_range_and_errors(lib, tmp_path):
 
 class _Stencil(ctypes.Structure):
     _fields_ = [("n", ctypes.c_int), ("idx", ctypes.c_int * 4), ("w", ctypes.c_double * 4),
-                ("lam", ctypes.c_double * 4), ("log_lam", ctypes.c_double * 4)]
+                ("lam", ctypes.c_double * 4), ("Rs", ctypes.c_double)]
 
 
 def test_c_largest_stiffness_bounds_the_law(lib, tmp_path):
@@ -200,3 +200,41 @@ def test_c_largest_stiffness_bounds_the_law(lib, tmp_path):
         tab.close()
     assert kmax >= k.max() * (1.0 - 1e-12)
     assert kmax <= 1.5 * k.max()  # the bound is the law's, not a loose one
+
+
+class _Result(ctypes.Structure):
+    _fields_ = [("F", ctypes.c_double), ("dF_dh", ctypes.c_double), ("a", ctypes.c_double),
+                ("h1", ctypes.c_double)]
+
+
+def test_c_force_only_evaluation_equals_the_full_one(lib, tmp_path):
+    """sct_eval_parts without a and h1 (what a frictionless code calls) gives the same F and dF/dh,
+    to the bit, as the full evaluation, on loading, unloading and beyond the table, between the
+    slices of a ratio-range table; the parts not asked for are 0."""
+    s1, s2 = Sphere(1e-3, STEEL), Sphere(1e-3, ALU)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", CalibrationRangeWarning)
+        write_table2(tmp_path / "r.sct", s1, s2, ratios=np.geomspace(0.5, 2.0, 5), probes=1)
+    lib.sct_stencil_for.argtypes = [ctypes.c_void_p, ctypes.c_double, ctypes.c_double,
+                                    ctypes.POINTER(_Stencil), ctypes.c_char_p, ctypes.c_size_t]
+    lib.sct_eval_parts.argtypes = [ctypes.c_void_p, ctypes.POINTER(_Stencil), ctypes.c_double,
+                                   ctypes.c_double, ctypes.c_int, ctypes.POINTER(_Result)]
+    tab = _Table(lib, tmp_path / "r.sct")
+    rng = np.random.default_rng(7)
+    st, full, part = _Stencil(), _Result(), _Result()
+    seen = {"loading": 0, "unloading": 0}
+    try:
+        for R2 in (0.6e-3, 1.3e-3, 1.9e-3):
+            assert lib.sct_stencil_for(tab.ptr, 1e-3, R2, ctypes.byref(st), None, 0) == 0
+            assert st.n == 4
+            for hm in np.exp(rng.uniform(np.log(1e-9), np.log(5e-4), 60)):
+                for h in (hm, 1.2 * hm, hm * (1 - 1e-3), hm * (1 - 1e-2)):
+                    lib.sct_eval_parts(tab.ptr, ctypes.byref(st), h, hm, 3, ctypes.byref(full))
+                    lib.sct_eval_parts(tab.ptr, ctypes.byref(st), h, hm, 0, ctypes.byref(part))
+                    assert (part.F, part.dF_dh) == (full.F, full.dF_dh)
+                    assert part.a == 0.0 and part.h1 == 0.0
+                    if full.F > 0:
+                        seen["loading" if h >= hm else "unloading"] += 1
+    finally:
+        tab.close()
+    assert min(seen.values()) > 100

@@ -6,6 +6,7 @@
 
 #include "spherecontact_table.h"
 
+#include <cmath>
 #include <string>
 
 namespace spherecontact_lmp {
@@ -28,14 +29,47 @@ void free_law(Law &law);
 // F, dF/dh from the table, v_n = (v_i - v_j).n the normal relative velocity (n from j to i, so
 // v_n < 0 on approach), m* the pair's reduced mass; gamma = fraction of the critical damping of
 // the normal oscillator linearised at the current stiffness.
-double damped_normal(double F, double dFdh, double vn, double meff, double gamma);
+inline double damped_normal(double F, double dFdh, double vn, double meff, double gamma)
+{
+  if (F <= 0.0) return 0.0;
+  double fn = F;
+  if (gamma > 0.0 && dFdh > 0.0) fn -= 2.0 * gamma * std::sqrt(meff * dFdh) * vn;
+  return fn > 0.0 ? fn : 0.0;
+}
 
 // Tangential force (Eq. T): spring xi (history, relative tangential displacement of i against j
 // at the contact), F_t = -k_t xi with k_t = 8 G* a; xi is first turned into the current tangent
 // plane keeping its length, then xi += v_t dt (if advance), and if |F_t| > mu F_n it is cut back
 // to Coulomb's limit (xi = -F_t / k_t). kt <= 0 or F_n <= 0: xi = 0, F_t = 0.
-void tangential(double kt, double mu, double Fn, const double n[3], const double vt[3], double dt,
-                bool advance, double xi[3], double ft[3]);
+inline void tangential(double kt, double mu, double Fn, const double n[3], const double vt[3],
+                       double dt, bool advance, double xi[3], double ft[3])
+{
+  if (kt <= 0.0 || Fn <= 0.0 || mu <= 0.0) {
+    xi[0] = xi[1] = xi[2] = ft[0] = ft[1] = ft[2] = 0.0;
+    return;
+  }
+  // turn the spring into the current tangent plane, keeping its length
+  double xn = xi[0] * n[0] + xi[1] * n[1] + xi[2] * n[2];
+  if (xn != 0.0) {
+    double len0 = std::sqrt(xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]);
+    for (int d = 0; d < 3; d++) xi[d] -= xn * n[d];
+    double len1 = std::sqrt(xi[0] * xi[0] + xi[1] * xi[1] + xi[2] * xi[2]);
+    if (len1 > 0.0)
+      for (int d = 0; d < 3; d++) xi[d] *= len0 / len1;
+  }
+  if (advance)
+    for (int d = 0; d < 3; d++) xi[d] += vt[d] * dt;
+  for (int d = 0; d < 3; d++) ft[d] = -kt * xi[d];
+  double f2 = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2];
+  double fmax = mu * Fn;
+  if (f2 > fmax * fmax) {    // sliding: Coulomb's limit, the spring stretched only as far as it holds
+    double s = fmax / std::sqrt(f2);
+    for (int d = 0; d < 3; d++) {
+      ft[d] *= s;
+      xi[d] = -ft[d] / kt;
+    }
+  }
+}
 
 }    // namespace spherecontact_lmp
 #endif

@@ -6,11 +6,13 @@
 #include "memory.h"
 
 #include <cstring>
+#include <utility>
 
 using namespace LAMMPS_NS;
 
 FixSphereContactHistory::FixSphereContactHistory(LAMMPS *lmp, int narg, char **arg) :
-    Fix(lmp, narg, arg), nmax(0), count(nullptr), rec(nullptr), nnew_local(0)
+    Fix(lmp, narg, arg), nmax(0), count(nullptr), rec(nullptr), next_count(nullptr),
+    next_rec(nullptr)
 {
   if (narg != 5) error->all(FLERR, "Illegal fix spherecontact/history command: NVALUE MAXCONTACTS");
   nv = utils::inumeric(FLERR, arg[3], false, lmp);
@@ -31,46 +33,27 @@ FixSphereContactHistory::~FixSphereContactHistory()
   atom->delete_callback(id, Atom::RESTART);
   memory->destroy(count);
   memory->destroy(rec);
-}
-
-const double *FixSphereContactHistory::find(int i, tagint key) const
-{
-  const double *r = rec[i];
-  for (int k = 0; k < count[i]; k++, r += stride)
-    if (static_cast<tagint>(ubuf(r[0]).i) == key) return r + 1;
-  return nullptr;
+  memory->destroy(next_count);
+  memory->destroy(next_rec);
 }
 
 void FixSphereContactHistory::begin(int nlocal)
 {
-  nnew_local = nlocal;
-  new_count.assign(nlocal, 0);
-  new_rec.resize(static_cast<size_t>(nlocal) * maxc * stride);
-}
-
-bool FixSphereContactHistory::add(int i, tagint key, const double *values)
-{
-  if (new_count[i] >= maxc) return false;
-  double *r = &new_rec[(static_cast<size_t>(i) * maxc + new_count[i]) * stride];
-  r[0] = ubuf(static_cast<int64_t>(key)).d;
-  std::memcpy(r + 1, values, nv * sizeof(double));
-  new_count[i]++;
-  return true;
+  for (int i = 0; i < nlocal; i++) next_count[i] = 0;
 }
 
 void FixSphereContactHistory::commit()
 {
-  for (int i = 0; i < nnew_local; i++) {
-    count[i] = new_count[i];
-    std::memcpy(rec[i], &new_rec[static_cast<size_t>(i) * maxc * stride],
-                new_count[i] * stride * sizeof(double));
-  }
+  std::swap(rec, next_rec);
+  std::swap(count, next_count);
 }
 
 void FixSphereContactHistory::grow_arrays(int n)
 {
   memory->grow(count, n, "spherecontact/history:count");
   memory->grow(rec, n, maxc * stride, "spherecontact/history:rec");
+  memory->grow(next_count, n, "spherecontact/history:next_count");
+  memory->grow(next_rec, n, maxc * stride, "spherecontact/history:next_rec");
   nmax = n;
 }
 
@@ -135,5 +118,5 @@ int FixSphereContactHistory::maxsize_restart()
 
 double FixSphereContactHistory::memory_usage()
 {
-  return static_cast<double>(nmax) * (sizeof(int) + maxc * stride * sizeof(double));
+  return 2.0 * nmax * (sizeof(int) + maxc * stride * sizeof(double));
 }

@@ -14,8 +14,6 @@
 
 #include "fix.h"
 
-#include <vector>
-
 namespace LAMMPS_NS {
 
 class FixSphereContactHistory : public Fix {
@@ -27,12 +25,26 @@ class FixSphereContactHistory : public Fix {
   int nvalue() const { return nv; }
   int maxcontacts() const { return maxc; }
   // the stored record of owned atom i for key, or nullptr (NVALUE doubles)
-  const double *find(int i, tagint key) const;
+  const double *find(int i, tagint key) const
+  {
+    const double *r = rec[i];
+    for (int k = 0; k < count[i]; k++, r += stride)
+      if (static_cast<tagint>(ubuf(r[0]).i) == key) return r + 1;
+    return nullptr;
+  }
 
-  // rewriting: begin(nlocal) clears the new lists, add() appends a record (false: atom full),
-  // commit() replaces the stored records of atoms 0..nlocal-1 with the new ones
+  // rewriting: begin(nlocal) clears the next records, add() appends a record to them (false: atom
+  // full), commit() makes them the stored ones (the two stores swap; atoms 0..nlocal-1 count)
   void begin(int nlocal);
-  bool add(int i, tagint key, const double *values);
+  bool add(int i, tagint key, const double *values)
+  {
+    if (next_count[i] >= maxc) return false;
+    double *r = next_rec[i] + next_count[i] * stride;
+    r[0] = ubuf(static_cast<int64_t>(key)).d;
+    for (int c = 0; c < nv; c++) r[c + 1] = values[c];
+    next_count[i]++;
+    return true;
+  }
   void commit();
 
   void grow_arrays(int) override;
@@ -51,9 +63,8 @@ class FixSphereContactHistory : public Fix {
   int nmax;
   int *count;              // records of each atom
   double **rec;            // [atom][k * stride]: key (as ubuf), then nv values
-  int nnew_local;
-  std::vector<int> new_count;
-  std::vector<double> new_rec;
+  int *next_count;         // the records being written in this step (begin/add), same layout
+  double **next_rec;
 };
 
 }    // namespace LAMMPS_NS

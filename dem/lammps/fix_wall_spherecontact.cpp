@@ -2,7 +2,7 @@
  * (body 2, rigid, flat) with n the wall's normal into the box:
  *   overlap h = R_i - (x_i - LO) (LO wall) or R_i - (HI - x_i) (HI wall); LO, HI constants or
  *   equal-style variables (v_name) evaluated every step, the wall velocity v_w = (LO_n - LO_{n-1})/dt
- *   F, dF/dh, a, h1 = sct_eval_stencil(h, h_max) at R1 = R_i, R2 = inf;  h_max <- max(h_max, h)
+ *   F, dF/dh, a, h1 = sct_eval_parts(h, h_max) at R1 = R_i, R2 = inf (a, h1 with friction);  h_max <- max(h_max, h)
  *   F_n = max(0, F - 2 gamma sqrt(m_i dF/dh) v_n), v = v_i - v_w         (Eq. N, m* = m_i)
  *   F_t = -8 G* a xi, |F_t| <= mu F_n, v_t = v - v_n n - d_i w_i x n    (Eq. T, d_i = R_i - h1)
  *   force on i: F_n n + F_t; torque -d_i n x F_t */
@@ -209,7 +209,7 @@ void FixWallSphereContact::post_force(int /*vflag*/)
       double rec[4] = {0.0, 0.0, 0.0, 0.0};    // h_max, spring xi
       if (old) std::memcpy(rec, old, sizeof rec);
       sct_result res;
-      sct_eval_stencil(law[w].tab, &st, h, rec[0], &res);
+      sct_eval_parts(law[w].tab, &st, h, rec[0], rot ? SCT_WANT_ALL : 0, &res);
       if (h > rec[0]) rec[0] = h;
       if (res.F > 0.0) {
         double n[3] = {0.0, 0.0, 0.0};
@@ -219,8 +219,8 @@ void FixWallSphereContact::post_force(int /*vflag*/)
                                 v[i][2] - (axis == 2 ? vwall[w] : 0.0)};
         const double vn = vrel[axis] * n[axis];
         double fn = damped_normal(res.F, res.dF_dh, vn, rmass[i], gamma), ft[3] = {0.0, 0.0, 0.0};
-        const double d = radius[i] - res.h1;
         if (rot) {
+          const double d = radius[i] - res.h1;
           const double *om = omega[i];
           double vt[3];
           vt[0] = vrel[0] - vn * n[0] - d * (om[1] * n[2] - om[2] * n[1]);

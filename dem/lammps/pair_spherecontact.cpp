@@ -2,7 +2,10 @@
  *
  * For each neighbour pair i, j (n = (x_i - x_j)/r from j to i):
  *   overlap           h = R_i + R_j - r
- *   normal (table)    F, dF/dh, a, h1 = sct_eval_stencil(h, h_max)      dem/FORMAT.md
+ *   stencil           the ratio stencil of R_i, R_j (sct_stencil_for), kept per neighbour-list
+ *                     slot and re-used while the slot's radii and types are the same
+ *   normal (table)    F, dF/dh, a, h1 = sct_eval_parts(h, h_max)        dem/FORMAT.md
+ *                     (a and h1 only with friction: they serve the tangential force alone)
  *   history           h_max <- max(h_max, h)
  *   damping (Eq. N)   F_n = max(0, F - 2 gamma sqrt(m* dF/dh) v_n)
  *   tangential (Eq. T) F_t = -8 G* a xi,  |F_t| <= mu F_n
@@ -153,6 +156,7 @@ void PairSphereContact::init_style()
     }
 
   neighbor->add_request(this, NeighConst::REQ_SIZE);
+  slots.clear();    // tables or radii may have changed since the last run
 
   // the history store: created once, re-used by later runs and restored by read_restart
   auto *f = modify->get_fix_by_id(history_id);
@@ -225,6 +229,32 @@ void PairSphereContact::print_time_step()
                    "step {:.6g}", update->dt, dtc);
 }
 
+/* The table of types it, jt, which atom is its body 1 (different types: pair_coeff's body1; same
+   type: the smaller atom if the table's ratio range allows, else the other) and the stencil of
+   the radii; an error naming the atoms if the ratio lies outside the table. */
+void PairSphereContact::stencil_of(int i, int j, int it, int jt, SlotStencil &s)
+{
+  double *radius = atom->radius;
+  const Law &law = laws[law_of[it][jt]];
+  bool i1 = (it != jt) ? (it == body1_of[it][jt]) : (radius[i] <= radius[j]);
+  char err[256];
+  if (sct_stencil_for(law.tab, i1 ? radius[i] : radius[j], i1 ? radius[j] : radius[i], &s.st, err,
+                      sizeof err) != SCT_OK) {
+    if (it != jt || sct_stencil_for(law.tab, i1 ? radius[j] : radius[i], i1 ? radius[i] : radius[j],
+                                    &s.st, nullptr, 0) != SCT_OK)
+      error->one(FLERR, "pair_style spherecontact: contact of atoms {} (type {}, radius {}) and {} "
+                 "(type {}, radius {}), table {}: {}", atom->tag[i], it, radius[i], atom->tag[j], jt,
+                 radius[j], law.file, err);
+    i1 = !i1;
+  }
+  s.Ri = radius[i];
+  s.Rj = radius[j];
+  s.ti = it;
+  s.tj = jt;
+  s.law = law_of[it][jt];
+  s.i1 = i1;
+}
+
 void PairSphereContact::compute(int eflag, int vflag)
 {
   ev_init(eflag, vflag);
@@ -239,10 +269,11 @@ void PairSphereContact::compute(int eflag, int vflag)
   const double dt = update->dt;
 
   history->begin(nlocal);
+  size_t slot = 0;    // running index of the neighbour-list slot
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];
-    for (int jj = 0; jj < list->numneigh[i]; jj++) {
+    for (int jj = 0; jj < list->numneigh[i]; jj++, slot++) {
       const int j = jlist[jj] & NEIGHMASK;
       const double del[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
       const double rsq = del[0] * del[0] + del[1] * del[1] + del[2] * del[2];
@@ -252,26 +283,20 @@ void PairSphereContact::compute(int eflag, int vflag)
       const double r = std::sqrt(rsq);
       const double h = radsum - r;    // overlap
 
-      // the table and which atom is its body 1 (same type: the smaller one if its range allows)
+      // the table, which atom is its body 1 and the ratio stencil: the slot's, or a new one
       const int it = type[i], jt = type[j];
-      const Law &law = laws[law_of[it][jt]];
-      bool i1 = (it != jt) ? (it == body1_of[it][jt]) : (radius[i] <= radius[j]);
-      sct_stencil st;
-      char err[256];
-      if (sct_stencil_for(law.tab, i1 ? radius[i] : radius[j], i1 ? radius[j] : radius[i], &st, err,
-                          sizeof err) != SCT_OK) {
-        if (it != jt || sct_stencil_for(law.tab, i1 ? radius[j] : radius[i],
-                                        i1 ? radius[i] : radius[j], &st, nullptr, 0) != SCT_OK)
-          error->one(FLERR, "pair_style spherecontact: contact of atoms {} (type {}, radius {}) "
-                     "and {} (type {}, radius {}), table {}: {}", tag[i], it, radius[i], tag[j], jt,
-                     radius[j], law.file, err);
-        i1 = !i1;
-      }
+      if (slot >= slots.size()) slots.resize(2 * slot + 64);
+      SlotStencil &ss = slots[slot];
+      if (!(ss.Ri == radius[i] && ss.Rj == radius[j] && ss.ti == it && ss.tj == jt))
+        stencil_of(i, j, it, jt, ss);
+      const Law &law = laws[ss.law];
+      const bool i1 = ss.i1;
+      const sct_stencil &st = ss.st;
 
       double rec[NVALUE] = {0.0, 0.0, 0.0, 0.0};    // h_max, xi (spring of i against j)
       if (old) std::memcpy(rec, old, sizeof rec);
       sct_result res;
-      sct_eval_stencil(law.tab, &st, h, rec[0], &res);
+      sct_eval_parts(law.tab, &st, h, rec[0], rot ? SCT_WANT_ALL : 0, &res);
       if (h > rec[0]) rec[0] = h;
 
       double fn = 0.0, ft[3] = {0.0, 0.0, 0.0}, n[3], d_i = 0.0, d_j = 0.0;

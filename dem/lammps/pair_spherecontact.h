@@ -39,6 +39,16 @@ class PairSphereContact : public Pair {
   class FixSphereContactHistory *history;
   std::string history_id;
 
+  // the stencil of each neighbour-list slot from the last step, re-used while the slot holds a
+  // pair of the same radii and types (between neighbour-list rebuilds: every step)
+  struct SlotStencil {
+    double Ri = -1.0, Rj = -1.0;
+    int ti = 0, tj = 0, law = -1, i1 = 0;
+    sct_stencil st;
+  };
+  std::vector<SlotStencil> slots;
+  void stencil_of(int i, int j, int it, int jt, SlotStencil &s);
+
   void allocate();
   int law_index(const std::string &file);
   void print_time_step();
