@@ -6,8 +6,9 @@ by spherecontact to a solid fraction of 0.65; its positions are then loaded into
 law, without walls and without time integration (no neighbour rebuild), and ``run STEPS`` is timed
 (best of REPEATS, the laws taking turns): each step evaluates every neighbour pair once. Two
 settings per law: normal force only, and with the tangential spring (friction 0.3; mdr and
-hertz/material with their history tangential models). Cost per contact = time per step / contacts (pairs with h > 0); the time per
-step includes LAMMPS' per-step overhead (the same for all laws).
+hertz/material with their history tangential models). Cost per contact = time per step /
+contacts (pairs with h > 0); the time per step includes LAMMPS' per-step overhead (the same for
+all laws).
 
     python -m bench.run_all lammps        # -> bench/results/lammps.json
 """
