@@ -360,6 +360,7 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
         st->w[0] = 1.0;
         st->lam[0] = Rs / t->sl[0].Rs;
         st->Rs = Rs;
+        st->h_elastic = t->sl[0].h_elastic * st->lam[0];
         return SCT_OK;
     }
     double x = log(ratio);
@@ -384,6 +385,8 @@ int sct_stencil_for(const sct_table *t, double R1, double R2, sct_stencil *st, c
         st->idx[a] = i0 + a;
         st->w[a] = w;
         st->lam[a] = Rs / t->sl[i0 + a].Rs;
+        double he = t->sl[i0 + a].h_elastic * st->lam[a];
+        if (a == 0 || he < st->h_elastic) st->h_elastic = he;
     }
     return SCT_OK;
 outside:
@@ -454,10 +457,7 @@ static inline void slice_in(const sct_slice *q, int j, double s, int parts, doub
 
 void sct_eval_parts(const sct_table *t, const sct_stencil *st, double h, double h_max, int want,
                     sct_result *out) {
-    int elastic = 1;
-    for (int i = 0; i < st->n; i++)
-        if (!(h_max <= t->sl[st->idx[i]].h_elastic * st->lam[i])) { elastic = 0; break; }
-    int loading = (h >= h_max) || elastic;
+    int loading = (h >= h_max) || (h_max <= st->h_elastic);
     double q = loading ? h : h_max;
     out->F = out->dF_dh = out->a = out->h1 = 0.0;
     if (!(q > 0.0)) return;

@@ -53,6 +53,7 @@ typedef struct {
     double w[SCT_ORDER];      /* Lagrange weights in ln(R2/R1) */
     double lam[SCT_ORDER];    /* size factors R* / R*_i */
     double Rs;                /* the contact's R* = R1 R2 / (R1 + R2) (R1 on a flat) */
+    double h_elastic;         /* a peak up to here is elastic: min over the slices of lam_i He_i */
 } sct_stencil;
 
 /* Load a table; NULL on failure with the reason (naming the file and the problem) in err. */

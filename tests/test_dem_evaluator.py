@@ -169,7 +169,7 @@ def test_c_evaluator_ratio_range_and_errors(lib, tmp_path):
 
 class _Stencil(ctypes.Structure):
     _fields_ = [("n", ctypes.c_int), ("idx", ctypes.c_int * 4), ("w", ctypes.c_double * 4),
-                ("lam", ctypes.c_double * 4), ("Rs", ctypes.c_double)]
+                ("lam", ctypes.c_double * 4), ("Rs", ctypes.c_double), ("h_elastic", ctypes.c_double)]
 
 
 def test_c_largest_stiffness_bounds_the_law(lib, tmp_path):

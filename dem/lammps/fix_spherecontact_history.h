@@ -33,6 +33,9 @@ class FixSphereContactHistory : public Fix {
     return nullptr;
   }
 
+  // ask the cache for atom i's stored records ahead of find(i, ...)
+  void prefetch(int i) const { __builtin_prefetch(rec[i]); }
+
   // rewriting: begin(nlocal) clears the next records, add() appends a record to them (false: atom
   // full), commit() makes them the stored ones (the two stores swap; atoms 0..nlocal-1 count)
   void begin(int nlocal);

@@ -273,6 +273,7 @@ void PairSphereContact::compute(int eflag, int vflag)
   for (int ii = 0; ii < list->inum; ii++) {
     const int i = list->ilist[ii];
     const int *jlist = list->firstneigh[i];
+    if (ii + 1 < list->inum) history->prefetch(list->ilist[ii + 1]);
     for (int jj = 0; jj < list->numneigh[i]; jj++, slot++) {
       const int j = jlist[jj] & NEIGHMASK;
       const double del[3] = {x[i][0] - x[j][0], x[i][1] - x[j][1], x[i][2] - x[j][2]};
