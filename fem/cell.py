@@ -117,7 +117,8 @@ class CellResult:
 
 
 class IncrementFailed(RuntimeError):
-    """Newton did not converge even after the increment cuts."""
+    """Newton did not converge (even after the increment cuts); ``args[1]``, when given, is the
+    :class:`CellResult` of the converged increments."""
 
 
 class _Contact:
@@ -275,13 +276,15 @@ def _increment(disc, con: _Contact, solver, material, state, u, active, offsets,
 
 def run_cell(scene: Scene | str, material: Material, h_values, density: float = 1.0,
              radius: float = 1.0, mesh_options: dict | None = None, tol: float = 1e-4,
-             max_iterations: int = 25, progress=None, mesh: OctantMesh | None = None) -> CellResult:
+             max_iterations: int = 25, progress=None, mesh: OctantMesh | None = None,
+             stop=None) -> CellResult:
     """Load the sphere of ``scene`` through the load approaches ``h_values`` (increasing).
 
     Each increment starts from the secant extrapolation of the last two converged ones; an
     increment that fails is cut in half (at most :data:`MAX_CUTS` times in a row) and the
     run stops with :class:`IncrementFailed` beyond that. ``mesh_options`` go to
-    :func:`.cell_mesh.build_octant_mesh` (the poles are the scene's flats).
+    :func:`.cell_mesh.build_octant_mesh` (the poles are the scene's flats). ``stop(result)``,
+    called after each increment, ends the run early when it returns True (e.g. a density reached).
     """
     t0, c0 = time.perf_counter(), time.process_time()
     sc = SCENES[scene] if isinstance(scene, str) else scene
@@ -311,10 +314,13 @@ def run_cell(scene: Scene | str, material: Material, h_values, density: float = 
         try:
             u_new, act_new, upd, its, tension = _increment(disc, con, solver, material, state, u_pred,
                                                            active, offsets, tol, max_iterations)
-        except IncrementFailed:
+        except IncrementFailed as err:
             cuts += 1
             if cuts > MAX_CUTS:
-                raise
+                res.wall_s = time.perf_counter() - t0
+                res.cpu_s = time.process_time() - c0
+                raise IncrementFailed(f"no convergence at h = {h:g} after {MAX_CUTS} cuts: {err}",
+                                      res) from err
             targets.append(0.5 * (h + h_prev))
             continue
         cuts = 0
@@ -350,6 +356,8 @@ def run_cell(scene: Scene | str, material: Material, h_values, density: float = 
         res.tension.append(tension)
         if progress is not None:
             progress(res)
+        if stop is not None and stop(res):
+            break
     res.wall_s = time.perf_counter() - t0
     res.cpu_s = time.process_time() - c0
     return res
