@@ -108,6 +108,8 @@ class CellResult:
     tension: list = field(default_factory=list)  # largest tensile nodal reaction / largest reaction
     wall_s: float = 0.0
     cpu_s: float = 0.0
+    u: np.ndarray | None = None  # displacement of the last converged increment (n_dofs,)
+    active: np.ndarray | None = None  # its contact state per node: flat index, −1 open
     n_nodes: int = 0
     n_elements: int = 0
 
@@ -354,6 +356,7 @@ def run_cell(scene: Scene | str, material: Material, h_values, density: float = 
         res.dissipation.append(dissip)
         res.newton.append(its)
         res.tension.append(tension)
+        res.u, res.active = u, active
         if progress is not None:
             progress(res)
         if stop is not None and stop(res):

@@ -20,23 +20,36 @@ SECTORS = 6
 #: open nodes within this many edge lengths beyond the closed ones enter the edge fit
 EDGE_BAND = 3.0
 EDGE_GRID = 201
+#: exponents p of the gap's opening g ≈ C (ρ − a)^p the fit may take: 1 (a plastic edge, the
+#: surface leaving the flat at an angle) to 2, as ``contact.EDGE_FITS["fitted"]``
+EDGE_EXPONENTS = tuple(np.linspace(1.0, 2.0, 21))
 
 
 def _edge_fit(rho: np.ndarray, gap: np.ndarray, sector: np.ndarray, lo: np.ndarray,
-              hi: np.ndarray) -> np.ndarray:
-    """Per sector s, the a in [lo_s, hi_s] of the least-squares g ≈ C (ρ − a)^{3/2}
-    over the points of that sector (arrays ``rho``, ``gap``, ``sector``)."""
+              hi: np.ndarray, exponents=None) -> np.ndarray:
+    """Per sector s, the a in [lo_s, hi_s] (and p of ``exponents``) of the least-squares
+    g ≈ C (ρ − a)^p over the points of that sector (arrays ``rho``, ``gap``, ``sector``)."""
+    exponents = EDGE_EXPONENTS if exponents is None else exponents
     t = np.linspace(0.0, 1.0, EDGE_GRID)
     a = lo[:, None] + (hi - lo)[:, None] * t[None, :]  # (S, G)
-    f = np.maximum(rho[:, None] - a[sector], 0.0) ** 1.5  # (n, G)
     n_s = lo.size
-    ff = np.zeros((n_s, EDGE_GRID))
-    fg = np.zeros((n_s, EDGE_GRID))
     gg = np.bincount(sector, weights=gap * gap, minlength=n_s)
-    np.add.at(ff, sector, f * f)
-    np.add.at(fg, sector, f * gap[:, None])
-    miss = gg[:, None] - np.where(ff > 0, fg * fg / np.where(ff > 0, ff, 1.0), 0.0)
-    return a[np.arange(n_s), np.argmin(miss, axis=1)]
+    best = np.full(n_s, np.inf)
+    a_best = 0.5 * (lo + hi)
+    d = np.maximum(rho[:, None] - a[sector], 0.0)  # (n, G)
+    for p in exponents:  # a few exponents, once per increment
+        f = d**p
+        ff = np.zeros((n_s, EDGE_GRID))
+        fg = np.zeros((n_s, EDGE_GRID))
+        np.add.at(ff, sector, f * f)
+        np.add.at(fg, sector, f * gap[:, None])
+        miss = gg[:, None] - np.where(ff > 0, fg * fg / np.where(ff > 0, ff, 1.0), 0.0)
+        j = np.argmin(miss, axis=1)
+        m = miss[np.arange(n_s), j]
+        better = m < best
+        best = np.where(better, m, best)
+        a_best = np.where(better, a[np.arange(n_s), j], a_best)
+    return a_best
 
 
 def patch_measures(x: np.ndarray, surface: np.ndarray, surface_edges: np.ndarray,
