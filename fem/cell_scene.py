@@ -74,6 +74,19 @@ class Scene:
             return d**3 / np.sqrt(2.0)
         return float("nan")
 
+    def approach_at_density(self, density: float, radius: float) -> float:
+        """The load approach h at which the relative density reaches ``density`` if the solid
+        volume stays 4π/3 R³ (plastic flow conserves it; elastic compression makes the actual h
+        slightly larger)."""
+        v = 4.0 / 3.0 * np.pi * radius**3 / density
+        if self.cell == "sc":
+            return 2.0 * radius - v ** (1.0 / 3.0)
+        if self.cell == "die":
+            return 2.0 * radius - v / (2.0 * radius) ** 2
+        if self.cell == "fcc":
+            return 2.0 * radius - (np.sqrt(2.0) * v) ** (1.0 / 3.0)
+        raise ValueError(f"scene {self.name!r} has no cell, hence no density")
+
     def density(self, volume: float, h: float, radius: float) -> float:
         """Relative density: solid volume ``volume`` over the cell volume (module docstring)."""
         return volume / self.cell_volume(h, radius)

@@ -37,6 +37,13 @@ def test_two_flats_epp_against_axisymmetric():
     assert abs(balance) < 0.01  # measured 0.68 % (10 increments)
 
 
+def test_approach_at_density_inverts_density():
+    for name in ("sc-isostatic", "sc-die", "fcc-isostatic"):
+        sc = SCENES[name]
+        h = sc.approach_at_density(0.85, 1.0)
+        assert sc.density(4 / 3 * np.pi, h, 1.0) == pytest.approx(0.85, rel=1e-12)
+
+
 def test_density_at_contact():
     V = 4 / 3 * np.pi
     assert SCENES["sc-isostatic"].density(V, 0.0, 1.0) == pytest.approx(np.pi / 6, rel=1e-14)
@@ -82,6 +89,7 @@ def test_cli_cell_refuses_bad_input(tmp_path):
     base = ["--E", "200", "--sigma-y", "1", "--out", str(out), "--quiet"]
     assert cli([*base, "--lattice", "fcc", "--load", "die", "--h-max", "0.01"]) == 2
     assert cli([*base, "--lattice", "sc", "--density-max", "0.5"]) == 2
+    assert cli([*base, "--lattice", "sc", "--load", "die", "--density-max", "0.9"]) == 2  # h ≈ 0.84 R
     assert cli([*base, "--lattice", "sc", "--h-max", "0.01", "--mesh-density", "3"]) == 2
     assert cli([*base, "--lattice", "sc", "--h-max", "0.01", "--E", "-1"]) == 2
     assert not out.exists()
