@@ -15,15 +15,15 @@ inside Newton: close on penetration, release on a tensile reaction; after
 :data:`MAX_RELEASES` set changes in an increment nodes are only closed (so the loop ends), and
 the largest remaining tensile reaction is reported.
 
-Newton: the consistent tangent of :func:`.constitutive3d.tangent3`, backtracking on the free
-residual's 2-norm (halving, at most :data:`LINE_SEARCH_HALVINGS` times; J > 0 enforced), and an
-increment that does not converge in ``max_iterations`` is cut in half (at most
-:data:`MAX_CUTS` times in a row).
+Newton: the consistent tangent of :func:`.constitutive3d.tangent3`, an energy line search
+(Crisfield 1991, §9.3: the step α accepted where |du · r̄(u + α du)| ≤ :data:`LINE_SEARCH_RATIO`
+|du · r̄(u)|, else a secant step on α, at most :data:`LINE_SEARCH_STEPS` times; halved where an
+element inverts), and an increment that does not converge in ``max_iterations`` is cut in half
+(at most :data:`MAX_CUTS` times in a row). Linear solves by CHOLMOD (:class:`_Cholesky`).
 """
 
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass, field
 
@@ -38,7 +38,7 @@ from .constitutive3d import PlasticState3, stress_update3, tangent3
 from .linsolve import SupernodalCholesky
 
 MAX_RELEASES = 8
-LINE_SEARCH_HALVINGS = 4
+LINE_SEARCH_STEPS = 4
 #: the line search accepts a step where |du · r̄| has fallen to this fraction of its start
 LINE_SEARCH_RATIO = 0.8
 MAX_CUTS = 6
@@ -46,7 +46,6 @@ MAX_CUTS = 6
 DEFINITE_SHIFT = 1e-6
 #: the active set is updated once the free residual is below this fraction of the largest reaction
 ACTIVE_SET_TOL = 1e-2
-_DEBUG = bool(os.environ.get("SPHERECONTACT_CELL_DEBUG"))
 
 
 class _Cholesky:
@@ -75,8 +74,6 @@ class _Cholesky:
                 V.data[on_diag] += shift
                 try:
                     self._chol.factor(V)
-                    if _DEBUG:
-                        print(f"    shifted by {shift:.2e}")
                     break
                 except ArithmeticError:
                     shift *= 4.0
@@ -223,8 +220,6 @@ def _increment(disc, con: _Contact, solver, material, state, u, active, offsets,
         lam = con.reactions(r, active)
         scale = max(float(np.max(np.abs(lam))), 1e-300)
         res_free = float(np.max(np.abs(rb[free]))) if free.size else 0.0
-        if _DEBUG:
-            print(f"  it {its} res {res_free / scale:.2e} active {np.sum(active >= 0)} changes {changes}")
         if its > 0 and res_free <= ACTIVE_SET_TOL * scale:  # primal–dual active set, near equilibrium
             pen = con.penetration(u, offsets)
             closing = (pen > 1e-12 * con.R) & (active[con.cand] < 0)
@@ -254,7 +249,7 @@ def _increment(disc, con: _Contact, solver, material, state, u, active, offsets,
         its += 1
         s0 = float(dub[free] @ rb[free])
         alpha, ev_new = 1.0, None
-        for _ls in range(LINE_SEARCH_HALVINGS + 1):  # energy line search (Crisfield 1991, §9.3)
+        for _ls in range(LINE_SEARCH_STEPS + 1):  # energy line search (Crisfield 1991, §9.3)
             trial = _evaluate(disc, u + alpha * du, state, material)
             if trial is None:  # J ≤ 0: halve
                 alpha *= 0.5
@@ -262,17 +257,14 @@ def _increment(disc, con: _Contact, solver, material, state, u, active, offsets,
             rt = trial[2] + D.T @ trial[2] if D is not None else trial[2]
             s1 = float(dub[free] @ rt[free])
             ev_new = (alpha, trial)
-            if abs(s1) <= LINE_SEARCH_RATIO * abs(s0) or s0 >= 0 or _ls == LINE_SEARCH_HALVINGS:
+            if abs(s1) <= LINE_SEARCH_RATIO * abs(s0) or s0 >= 0 or _ls == LINE_SEARCH_STEPS:
                 break
             # secant root of s(α) = du · r̄(u + α du) between 0 and α, kept within [0.1, 1] α
             alpha = alpha * float(np.clip(s0 / (s0 - s1), 0.1, 1.0)) if s1 != s0 else 0.5 * alpha
         if ev_new is None:
             raise IncrementFailed("every line-search step inverts an element")
-        best = (0.0, ev_new[0], ev_new[1])
-        if _DEBUG:
-            print(f"    alpha {best[1]:g}")
-        u = u + best[1] * du
-        ev = best[2]
+        u = u + ev_new[0] * du
+        ev = ev_new[1]
     raise IncrementFailed(f"Newton did not converge in {max_iterations} iterations")
 
 
