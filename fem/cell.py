@@ -1,25 +1,25 @@
-"""3D large-deformation FE of one sphere in a lattice cell: octant mesh, assembly, two-flat scene.
+"""3D large-deformation FE of one sphere in a lattice cell: the solver (issue 62).
 
-First scene (issue 62): a sphere of radius R squeezed between two rigid frictionless
-plates, the axisymmetric flat scene in 3D and the 3D solver's own verification. With the
-sphere centred at the origin, the planes x = 0, y = 0, z = 0 are symmetry planes; the octant
-x, y, z ≥ 0 is meshed and the upper plate sits at z = R − h/2 (h: the change of the plates'
-separation 2R − d). Each half of the sphere is then a hemisphere on a rigid flat with
-approach h/2, so F(h) of this scene equals F_ax(h/2) of ``spherecontact fem run`` (flat
-obstacle), the plate force F = 4 × the octant's reaction.
+The sphere (radius R, centre at the origin) meets rigid frictionless flats (:mod:`.cell_scene`);
+the octant x, y, z ≥ 0 is modelled (:mod:`.cell_mesh`), symmetry planes x = 0, y = 0, z = 0.
 
-Kinematics: total Lagrangian, F = I + ∂u/∂X at the quadrature points; virtual work
+Kinematics: total Lagrangian, virtual work f_int = ∫ Bᵀ P dV₀, K = ∫ Bᵀ A B dV₀ (Wriggers
+2008, §4.2), with the constitutive update of :mod:`.constitutive3d` (shared with the
+axisymmetric solver). Quadratic tetrahedra (10 nodes), 4-point Gauss rule.
 
-    f_int = ∫ Bᵀ P dV₀,   K = ∫ Bᵀ A B dV₀,   A = ∂P/∂F                   (Wriggers 2008, §4.2)
+Contact: exact, as in the axisymmetric solver (:mod:`.contact`). A closed node a of flat k has
+n_k · x_a = R − h_k/2 prescribed in a nodal frame Q_a = [n_k, e_j × n_k, e_j] (e_j an axis with
+n_k,j = 0; Q_a = I for an axis-aligned flat), an open one carries no force; u = T ū with T the
+block-diagonal of the frames, K̄ = Tᵀ K T, r̄ = Tᵀ r. The active set is a primal–dual one updated
+inside Newton: close on penetration, release on a tensile reaction; after
+:data:`MAX_RELEASES` set changes in an increment nodes are only closed (so the loop ends), and
+the largest remaining tensile reaction is reported.
 
-with the constitutive update of :mod:`.constitutive3d` (shared with the axisymmetric solver).
-Quadratic tetrahedra (10 nodes, isoparametric: midside nodes of the sphere's surface on the
-sphere), 4-point Gauss rule.
-
-Contact: exact, as in the axisymmetric solver (:mod:`.contact`): an active node has its
-z displacement prescribed onto the plate (g = 0), an inactive one carries no force; the
-active set is updated after each converged Newton loop (close on penetration, release on
-a tensile reaction) until it no longer changes. No penalty number.
+Newton: the consistent tangent of :func:`.constitutive3d.tangent3`, an energy line search
+(Crisfield 1991, §9.3: the step α accepted where |du · r̄(u + α du)| ≤ :data:`LINE_SEARCH_RATIO`
+|du · r̄(u)|, else a secant step on α, at most :data:`LINE_SEARCH_STEPS` times; halved where an
+element inverts), and an increment that does not converge in ``max_iterations`` is cut in half
+(at most :data:`MAX_CUTS` times in a row). Linear solves by CHOLMOD (:class:`_Cholesky`).
 """
 
 from __future__ import annotations
@@ -29,281 +29,337 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-import skfem
 
 from ..model.material import Material
+from .cell_mesh import Discretisation3, OctantMesh, build_octant_mesh
+from .cell_patch import patch_measures
+from .cell_scene import SCENES, Scene
 from .constitutive3d import PlasticState3, stress_update3, tangent3
-from .linsolve import SymmetricSolver
-from .mesh import _gmsh_initialize
+from .linsolve import SupernodalCholesky
 
-#: element sizes (units of R) at density 1: at the contact pole, far from it, and the growth
-#: of the size with distance from the pole
-SIZE_POLE = 0.03
-SIZE_BULK = 0.25
-SIZE_GROWTH = 0.6
-
-
-@dataclass(frozen=True)
-class OctantMesh:
-    """Quadratic tetrahedral mesh of the sphere octant x, y, z ≥ 0, |X| ≤ R.
-
-    Attributes
-    ----------
-    mesh : skfem.MeshTet2 (sphere-surface midside nodes on the sphere).
-    X : (3, n_nodes) reference coordinates of the 10-node tetrahedra's nodes.
-    sphere : node indices on the spherical surface.
-    sphere_facets : (3, m) corner nodes of the boundary triangles on the sphere.
-    """
-
-    mesh: skfem.MeshTet2
-    X: np.ndarray
-    sphere: np.ndarray
-    sphere_facets: np.ndarray
-    radius: float
-    density: float
+MAX_RELEASES = 8
+LINE_SEARCH_STEPS = 4
+#: the line search accepts a step where |du · r̄| has fallen to this fraction of its start
+LINE_SEARCH_RATIO = 0.8
+MAX_CUTS = 6
+#: diagonal shift (fraction of the largest diagonal entry) of a tangent Cholesky refuses
+DEFINITE_SHIFT = 1e-6
+#: the active set is updated once the free residual is below this fraction of the largest reaction
+ACTIVE_SET_TOL = 1e-2
 
 
-def build_octant_mesh(radius: float = 1.0, density: float = 1.0) -> OctantMesh:
-    """Octant of a sphere meshed by gmsh (OCC sphere ∩ box, Delaunay tetrahedra) under the size
-    field s(X) = min(S_bulk, S_pole + g |X − R e_z|)/density: finest at the pole the plate
-    touches. Made quadratic by skfem (``MeshTet2.from_mesh``) with the midside nodes of the
-    sphere's surface edges projected onto the sphere (exact surface to second order)."""
-    import gmsh
+class _Cholesky:
+    """K x = b by CHOLMOD's supernodal Cholesky (:class:`.linsolve.SupernodalCholesky`), the
+    analysis redone only when the pattern changes; a tangent that is not positive definite is
+    factored with its diagonal raised by :data:`DEFINITE_SHIFT` × its largest entry, doubled
+    until it is (a damped Newton step, left to the line search)."""
 
-    _gmsh_initialize(gmsh)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.model.add("octant")
-        occ = gmsh.model.occ
-        ball = occ.addSphere(0, 0, 0, 1.0)
-        box = occ.addBox(0, 0, 0, 1.0, 1.0, 1.0)
-        occ.intersect([(3, ball)], [(3, box)])
-        occ.synchronize()
-        f = gmsh.model.mesh.field
-        fid = f.add("MathEval")
-        f.setString(fid, "F", f"Min({SIZE_BULK / density}, ({SIZE_POLE} + {SIZE_GROWTH}"
-                              f"*Sqrt(x*x + y*y + (z - 1)*(z - 1)))/{density})")
-        f.setAsBackgroundMesh(fid)
-        for key in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints",
-                    "Mesh.MeshSizeFromCurvature"):
-            gmsh.option.setNumber(key, 0)
-        gmsh.model.mesh.generate(3)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        _, _, conn = gmsh.model.mesh.getElements(3)
-    finally:
-        gmsh.finalize()
-    order = np.zeros(int(tags.max()) + 1, dtype=np.int64)
-    order[tags.astype(np.int64)] = np.arange(tags.size)
-    p = xyz.reshape(-1, 3).T
-    t = order[np.asarray(conn[0], dtype=np.int64)].reshape(-1, 4).T
-    used = np.unique(t)
-    remap = np.full(p.shape[1], -1)
-    remap[used] = np.arange(used.size)
-    m1 = skfem.MeshTet1(p[:, used], remap[t])
-    m2 = skfem.MeshTet2.from_mesh(m1)
-    nv = m1.p.shape[1]
-    onsphere = np.abs(np.linalg.norm(m1.p, axis=0) - 1.0) < 1e-8
-    bf = m1.boundary_facets()
-    sf = bf[np.all(onsphere[m1.facets[:, bf]], axis=0)]
-    tri = m1.facets[:, sf]
-    # midside dofs of the sphere's triangles: edge index of each corner pair, + nv
-    ekeys = np.sort(m1.edges, axis=0)
-    ekey = ekeys[0] * nv + ekeys[1]
-    srt = np.argsort(ekey)
-    pairs = np.sort(np.stack([tri[[0, 1, 2]], tri[[1, 2, 0]]]), axis=0)
-    pk = (pairs[0] * nv + pairs[1]).ravel()
-    eidx = srt[np.searchsorted(ekey[srt], pk)]
-    mid = np.unique(eidx) + nv
-    X = m2.doflocs.copy()
-    X[:, mid] /= np.linalg.norm(X[:, mid], axis=0)
-    sphere = np.concatenate([np.flatnonzero(onsphere), mid])
-    from dataclasses import replace
-    m2 = replace(m2, doflocs=X * radius)
-    return OctantMesh(mesh=m2, X=X * radius, sphere=np.sort(sphere), sphere_facets=tri,
-                      radius=float(radius), density=float(density))
+    def __init__(self):
+        self._key, self._chol = None, None
 
-
-class Discretisation3:
-    """Element arrays of a quadratic tetrahedral mesh: B (∂u/∂X → F), weights, dofs, CSR pattern.
-
-    F[3i+j] = δ_ij + Σ_a ∂N_a/∂X_j u_ai; dof 3a + i is node a's displacement along X_i.
-    """
-
-    def __init__(self, omesh: OctantMesh):
-        self.omesh = omesh
-        basis = skfem.Basis(omesh.mesh, skfem.ElementTetP2(), intorder=2)
-        nbf, nel = basis.Nbfun, basis.nelems
-        nqp = basis.X.shape[1]
-        self.n_nodes, self.n_dofs = int(basis.N), 3 * int(basis.N)
-        self.n_elements, self.n_qp = nel, nqp
-        self.weights = np.asarray(basis.dx).reshape(-1)
-        dphi = np.stack([basis.basis[i][0].grad for i in range(nbf)])  # (nbf, 3, nel, nqp)
-        B = np.zeros((nel, nqp, 3, 3, nbf, 3))
-        for i in range(3):  # components of u (3 fixed iterations, not over points)
-            B[:, :, i, :, :, i] = dphi.transpose(2, 3, 1, 0)
-        self.B = B.reshape(nel * nqp, 9, 3 * nbf)
-        nodes = basis.element_dofs  # (nbf, nel)
-        edofs = 3 * nodes[:, :, None] + np.arange(3)[None, None, :]
-        self.edofs = edofs.transpose(1, 0, 2).reshape(nel, 3 * nbf)
-        self.qp_dofs = np.repeat(self.edofs, nqp, axis=0)
-        ne = self.edofs.shape[1]
-        rows = np.repeat(self.edofs[:, :, None], ne, axis=2).ravel().astype(np.int64)
-        cols = np.repeat(self.edofs[:, None, :], ne, axis=1).ravel().astype(np.int64)
-        keys, self._slot = np.unique(rows * self.n_dofs + cols, return_inverse=True)
-        self._rows, self._cols = np.divmod(keys, self.n_dofs)
-
-    def deformation_gradient(self, u: np.ndarray) -> np.ndarray:
-        """F (n_points, 3, 3) at the quadrature points for nodal displacements u (n_dofs,)."""
-        grad = np.einsum("qkj,qj->qk", self.B, u[self.qp_dofs])
-        return grad.reshape(-1, 3, 3) + np.eye(3)
-
-    def internal_force(self, P: np.ndarray) -> np.ndarray:
-        """f_int = Σ_q w_q Bᵀ P (P: (n_points, 3, 3))."""
-        fe = np.einsum("qkj,qk->qj", self.B, P.reshape(-1, 9) * self.weights[:, None])
-        return np.bincount(self.qp_dofs.ravel(), weights=fe.ravel(), minlength=self.n_dofs)
-
-    def tangent(self, A: np.ndarray) -> sp.csr_matrix:
-        """K = Σ_q w_q Bᵀ A B (A: (n_points, 9, 9)) on the fixed pattern."""
-        AB = np.matmul(A * self.weights[:, None, None], self.B)
-        nel, nqp, nb = self.n_elements, self.n_qp, self.B.shape[2]
-        Bt = self.B.reshape(nel, nqp * 9, nb).transpose(0, 2, 1)
-        Ke = np.matmul(Bt, AB.reshape(nel, nqp * 9, nb))
-        data = np.bincount(self._slot, weights=Ke.ravel())
-        return sp.csr_matrix((data, (self._rows, self._cols)), shape=(self.n_dofs,) * 2)
-
-    def integrate(self, values: np.ndarray) -> float:
-        return float(np.dot(self.weights, values))
+    def solve(self, K: sp.csc_matrix, b: np.ndarray) -> np.ndarray:
+        U = sp.triu(K, format="csc")
+        U.sort_indices()
+        key = (U.shape[0], hash(U.indptr.tobytes()), hash(U.indices.tobytes()))
+        if key != self._key:
+            self._chol, self._key = SupernodalCholesky(U), key
+        try:
+            self._chol.factor(U)
+        except ArithmeticError:
+            d = U.diagonal()
+            on_diag = np.flatnonzero(U.indices == np.repeat(np.arange(U.shape[0]), np.diff(U.indptr)))
+            shift = DEFINITE_SHIFT * float(np.max(np.abs(d)))
+            for _ in range(40):
+                V = U.copy()
+                V.data[on_diag] += shift
+                try:
+                    self._chol.factor(V)
+                    break
+                except ArithmeticError:
+                    shift *= 4.0
+            else:
+                raise IncrementFailed("tangent not positive definite even when shifted") from None
+        return np.asarray(self._chol.solve(b)).ravel()
 
 
 @dataclass
-class TwoFlatResult:
-    """Curves of a two-plate run, per converged increment (full sphere: 8 × the octant)."""
+class CellResult:
+    """Curves of a cell run per converged increment; forces, areas and energies of the whole
+    sphere (the octant's × multiplicity or × 8). Per-contact arrays have one column per flat."""
 
-    h: list = field(default_factory=list)  # plate approach 2R − d
-    F: list = field(default_factory=list)  # plate force (4 × the octant's reaction)
-    A: list = field(default_factory=list)  # contact area: closed sphere triangles, deformed
-    a_nodes: list = field(default_factory=list)  # largest deformed radius of a closed node
-    work: list = field(default_factory=list)  # external work ∫ F dh (trapezoid)
-    stored: list = field(default_factory=list)  # elastic energy ∫ ψ dV
-    dissipation: list = field(default_factory=list)  # plastic work Σ ∫ σ_f Δγ dV
+    scene: str
+    h: list = field(default_factory=list)  # load approach
+    hk: list = field(default_factory=list)  # per-contact approach
+    F: list = field(default_factory=list)  # per-contact force (normal reaction)
+    A: list = field(default_factory=list)  # per-contact area (cell_patch)
+    a: list = field(default_factory=list)  # per-contact √(A/π)
+    a_min: list = field(default_factory=list)  # patch extent: smallest sector radius
+    a_max: list = field(default_factory=list)  # ... largest
+    a_nodes: list = field(default_factory=list)  # largest radius of a closed node
+    volume: list = field(default_factory=list)  # solid volume 8 ∫ J dV₀
+    density: list = field(default_factory=list)  # relative density (cell_scene)
+    work: list = field(default_factory=list)  # external work Σ F_k dh_k (trapezoid)
+    stored: list = field(default_factory=list)  # elastic energy ∫ ψ dV₀
+    dissipation: list = field(default_factory=list)  # plastic work Σ ∫ σ_f Δγ dV₀
     newton: list = field(default_factory=list)  # Newton iterations per increment
+    tension: list = field(default_factory=list)  # largest tensile nodal reaction / largest reaction
     wall_s: float = 0.0
+    cpu_s: float = 0.0
+    u: np.ndarray | None = None  # displacement of the last converged increment (n_dofs,)
+    active: np.ndarray | None = None  # its contact state per node: flat index, −1 open
     n_nodes: int = 0
     n_elements: int = 0
 
+    def arrays(self) -> dict:
+        """The curves as numpy arrays."""
+        return {k: np.asarray(v) for k, v in self.__dict__.items() if isinstance(v, list)}
+
 
 class IncrementFailed(RuntimeError):
-    """Newton or the active-set loop did not converge."""
+    """Newton did not converge (even after the increment cuts); ``args[1]``, when given, is the
+    :class:`CellResult` of the converged increments."""
 
 
-def _contact_area(x: np.ndarray, tri: np.ndarray, closed: np.ndarray) -> float:
-    """Deformed area of the sphere triangles whose three corners are all closed (flat
-    triangles on the corners; the closed ones lie in the plate)."""
-    sel = tri[:, np.all(closed[tri], axis=0)]
-    if sel.size == 0:
-        return 0.0
-    v1 = x[:, sel[1]] - x[:, sel[0]]
-    v2 = x[:, sel[2]] - x[:, sel[0]]
-    return float(0.5 * np.linalg.norm(np.cross(v1.T, v2.T), axis=1).sum())
+class _Contact:
+    """Flats, nodal frames and constraint bookkeeping of one mesh and scene."""
+
+    def __init__(self, om: OctantMesh, scene: Scene):
+        X, R = om.X, om.radius
+        self.X, self.R = X, R
+        self.normals = scene.normals
+        self.mult = scene.multiplicity
+        k = self.normals.shape[0]
+        self.Q = np.repeat(np.eye(3)[None], k, axis=0)
+        self.ncol = np.zeros(k, dtype=np.int64)
+        self.oblique = np.zeros(k, dtype=bool)
+        for i, n in enumerate(self.normals):  # a handful of flats, once
+            nz = np.flatnonzero(np.abs(n) > 1e-12)
+            if nz.size == 1:
+                self.ncol[i] = nz[0]
+            else:
+                e = np.eye(3)[np.flatnonzero(np.abs(n) < 1e-12)[-1]]
+                self.Q[i] = np.column_stack([n, np.cross(e, n), e])
+                self.oblique[i] = True
+        self.on_plane = (np.abs(X) < 1e-12 * R).T  # (n_nodes, 3)
+        s = om.sphere
+        proj = self.normals @ X[:, s] / R  # (k, n_sphere)
+        best = np.argmax(proj, axis=0)
+        ok = proj[best, np.arange(s.size)] > 0.5
+        self.cand, self.cand_flat = s[ok], best[ok]  # nodes that can meet a flat, and which
+        tri = om.sphere_facets
+        self.edges = np.unique(np.sort(np.concatenate([tri[[0, 1]], tri[[1, 2]], tri[[2, 0]]], axis=1),
+                                       axis=0), axis=1)
+
+    def frames(self, active: np.ndarray):
+        """(D, fixed): D = T − I (sparse, None when every frame is I); fixed (n_dofs,) bool of
+        the frame dofs held (symmetry planes, the normal of closed nodes)."""
+        n_nodes = active.size
+        Q = np.broadcast_to(np.eye(3), (n_nodes, 3, 3)).copy()
+        act = np.flatnonzero(active >= 0)
+        Q[act] = self.Q[active[act]]
+        fixed = np.einsum("aj,ajc->ac", self.on_plane.astype(float), np.abs(Q)) > 0.5
+        fixed[act, self.ncol[active[act]]] = True
+        obl = act[self.oblique[active[act]]]
+        D = None
+        if obl.size:
+            blocks = Q[obl] - np.eye(3)
+            rows = (3 * obl[:, None, None] + np.arange(3)[None, :, None]).repeat(3, axis=2)
+            cols = (3 * obl[:, None, None] + np.arange(3)[None, None, :]).repeat(3, axis=1)
+            D = sp.csr_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(3 * n_nodes,) * 2)
+        return D, fixed.ravel()
+
+    def project(self, u: np.ndarray, active: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+        """u with every closed node moved along its flat's normal onto the flat."""
+        act = np.flatnonzero(active >= 0)
+        n = self.normals[active[act]]  # (m, 3)
+        x = self.X[:, act].T + u.reshape(-1, 3)[act]
+        u = u.copy().reshape(-1, 3)
+        u[act] += n * (offsets[active[act]] - np.sum(n * x, axis=1))[:, None]
+        return u.ravel()
+
+    def reactions(self, r: np.ndarray, active: np.ndarray) -> np.ndarray:
+        """Normal reaction λ_a = −n · r_a of every closed node (0 on open ones)."""
+        lam = np.zeros(active.size)
+        act = np.flatnonzero(active >= 0)
+        lam[act] = -np.sum(self.normals[active[act]] * r.reshape(-1, 3)[act], axis=1)
+        return lam
+
+    def penetration(self, u: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+        """n · x − offset of every candidate node on its flat (> 0: through it)."""
+        x = self.X[:, self.cand] + u.reshape(-1, 3)[self.cand].T
+        return np.sum(self.normals[self.cand_flat].T * x, axis=0) - offsets[self.cand_flat]
 
 
-def run_two_flats(material: Material, h_values, density: float = 1.0, radius: float = 1.0,
-                  tol: float = 1e-4, max_iterations: int = 25, progress=None) -> TwoFlatResult:
-    """Squeeze the sphere between two rigid frictionless plates through the approaches
-    ``h_values`` (increasing, units of length; h = 2R − d), octant model (module docstring).
+def _evaluate(disc: Discretisation3, u, state: PlasticState3, material: Material):
+    """(F, update, f_int) at u, or None where an element inverts (J ≤ 0)."""
+    Fq = disc.deformation_gradient(u)
+    if np.any(np.linalg.det(Fq) <= 0):
+        return None
+    upd = stress_update3(Fq, state.cp_inv, state.eps_p, material)
+    return Fq, upd, disc.internal_force(upd.P)
 
-    Each increment: the displacement of the last one extrapolated (secant predictor), the
-    active nodes moved onto the plate, then Newton on the free dofs (exact tangent up to the
-    central-difference error of :func:`.constitutive3d.tangent3`) until
-    ‖r_free‖∞ ≤ tol · max|reaction|, then the active set updated and Newton repeated until
-    it is unchanged. Raises :class:`IncrementFailed` when Newton does not converge.
+
+def _increment(disc, con: _Contact, solver, material, state, u, active, offsets, tol, max_iterations):
+    """Newton with the primal–dual active set for one increment (module docstring).
+
+    Returns (u, active, update, iterations, tension) or raises :class:`IncrementFailed`."""
+    active = active.copy()
+    pen = con.penetration(u, offsets)
+    close = pen > 0
+    active[con.cand[close]] = con.cand_flat[close]
+    u = con.project(u, active, offsets)
+    ev = _evaluate(disc, u, state, material)
+    if ev is None:
+        raise IncrementFailed("inverted element at the predictor")
+    changes, its = 0, 0
+    for _it in range(max_iterations + 2 * MAX_RELEASES + 20):
+        Fq, upd, r = ev
+        D, fixed = con.frames(active)
+        rb = r + D.T @ r if D is not None else r
+        free = np.flatnonzero(~fixed)
+        lam = con.reactions(r, active)
+        scale = max(float(np.max(np.abs(lam))), 1e-300)
+        res_free = float(np.max(np.abs(rb[free]))) if free.size else 0.0
+        if its > 0 and res_free <= ACTIVE_SET_TOL * scale:  # primal–dual active set, near equilibrium
+            pen = con.penetration(u, offsets)
+            closing = (pen > 1e-12 * con.R) & (active[con.cand] < 0)
+            releasing = (lam < 0) & (changes < MAX_RELEASES)
+            if np.any(closing) or np.any(releasing):
+                changes += 1
+                active[releasing] = -1
+                active[con.cand[closing]] = con.cand_flat[closing]
+                u = con.project(u, active, offsets)
+                ev = _evaluate(disc, u, state, material)
+                if ev is None:
+                    raise IncrementFailed("inverted element after an active-set change")
+                continue
+            if res_free <= tol * scale:
+                tension = max(0.0, float(-lam.min())) / scale
+                return u, active, upd, its, tension
+        if its >= max_iterations:
+            break
+        K = disc.tangent(tangent3(Fq, state, material, upd))
+        if D is not None:
+            KD = K @ D
+            K = K + KD + D.T @ K + D.T @ KD
+        K = K.tocsc()
+        dub = np.zeros_like(u)
+        dub[free] = solver.solve(K[free][:, free], -rb[free])
+        du = dub + D @ dub if D is not None else dub
+        its += 1
+        s0 = float(dub[free] @ rb[free])
+        alpha, ev_new = 1.0, None
+        for _ls in range(LINE_SEARCH_STEPS + 1):  # energy line search (Crisfield 1991, §9.3)
+            trial = _evaluate(disc, u + alpha * du, state, material)
+            if trial is None:  # J ≤ 0: halve
+                alpha *= 0.5
+                continue
+            rt = trial[2] + D.T @ trial[2] if D is not None else trial[2]
+            s1 = float(dub[free] @ rt[free])
+            ev_new = (alpha, trial)
+            if abs(s1) <= LINE_SEARCH_RATIO * abs(s0) or s0 >= 0 or _ls == LINE_SEARCH_STEPS:
+                break
+            # secant root of s(α) = du · r̄(u + α du) between 0 and α, kept within [0.1, 1] α
+            alpha = alpha * float(np.clip(s0 / (s0 - s1), 0.1, 1.0)) if s1 != s0 else 0.5 * alpha
+        if ev_new is None:
+            raise IncrementFailed("every line-search step inverts an element")
+        u = u + ev_new[0] * du
+        ev = ev_new[1]
+    raise IncrementFailed(f"Newton did not converge in {max_iterations} iterations")
+
+
+def run_cell(scene: Scene | str, material: Material, h_values, density: float = 1.0,
+             radius: float = 1.0, mesh_options: dict | None = None, tol: float = 1e-4,
+             max_iterations: int = 25, progress=None, mesh: OctantMesh | None = None,
+             stop=None) -> CellResult:
+    """Load the sphere of ``scene`` through the load approaches ``h_values`` (increasing).
+
+    Each increment starts from the secant extrapolation of the last two converged ones; an
+    increment that fails is cut in half (at most :data:`MAX_CUTS` times in a row) and the
+    run stops with :class:`IncrementFailed` beyond that. ``mesh_options`` go to
+    :func:`.cell_mesh.build_octant_mesh` (the poles are the scene's flats). ``stop(result)``,
+    called after each increment, ends the run early when it returns True (e.g. a density reached).
     """
-    t0 = time.perf_counter()
-    om = build_octant_mesh(radius, density)
+    t0, c0 = time.perf_counter(), time.process_time()
+    sc = SCENES[scene] if isinstance(scene, str) else scene
+    om = mesh if mesh is not None else build_octant_mesh(radius, density, poles=sc.normals,
+                                                         **(mesh_options or {}))
     disc = Discretisation3(om)
-    X = om.X
-    nd = disc.n_dofs
-    fixed_sym = np.concatenate([3 * np.flatnonzero(np.abs(X[0]) < 1e-12),
-                                3 * np.flatnonzero(np.abs(X[1]) < 1e-12) + 1,
-                                3 * np.flatnonzero(np.abs(X[2]) < 1e-12) + 2])
-    cand = om.sphere[X[2, om.sphere] > 0.5 * radius]  # nodes that can meet the upper plate
-    active = np.zeros(X.shape[1], dtype=bool)
+    con = _Contact(om, sc)
+    R = om.radius
+    res = CellResult(scene=sc.name, n_nodes=om.X.shape[1], n_elements=disc.n_elements)
+    solver = _Cholesky()
     state = PlasticState3.virgin(disc.n_elements * disc.n_qp)
-    u = np.zeros(nd)
-    u_prev, h_prev = np.zeros(nd), 0.0
-    res = TwoFlatResult(n_nodes=X.shape[1], n_elements=disc.n_elements)
-    solver = SymmetricSolver("ldl")
-    work, F_last = 0.0, 0.0
-    for h in h_values:
-        zp = radius - 0.5 * h
-        if len(res.h) > 1:  # secant predictor through the last two converged increments
-            u_conv = u.copy()
-            u = u + (u - u_prev) * (h - h_prev) / (h_prev - res.h[-2])
-            u_prev = u_conv
-        else:
-            u_prev = u.copy()
-        # close every candidate the predicted (first increment: reference) surface puts
-        # through the plate
-        xz = X[2, cand] + u[3 * cand + 2]
-        active[cand[xz > zp]] = True
-        its = 0
-        du, free = None, None
-        for _it in range(3 * max_iterations):  # Newton with the active set updated in the loop
-            cdofs = 3 * np.flatnonzero(active) + 2
-            u[cdofs] = zp - X[2, active]
-            u[fixed_sym] = 0.0
-            fixed = np.zeros(nd, dtype=bool)
-            fixed[fixed_sym] = True
-            fixed[cdofs] = True
-            Fq = disc.deformation_gradient(u)
-            step = 1.0
-            while np.any(np.linalg.det(Fq) <= 0):  # J > 0 guard: halve the Newton step
-                if du is None or step < 1e-3:
-                    raise IncrementFailed(f"inverted element at h = {h:g}")
-                step *= 0.5
-                u[free] -= step * du
-                Fq = disc.deformation_gradient(u)
-            free = np.flatnonzero(~fixed)
-            upd = stress_update3(Fq, state.cp_inv, state.eps_p, material)
-            r = disc.internal_force(upd.P)
-            react = -r[cdofs]
-            scale = max(np.max(np.abs(react)), 1e-300)
-            its += 1
-            if _it > 0:  # primal-dual active set: release tension, close penetration
-                x = X + u.reshape(-1, 3).T
-                pen = cand[(~active[cand]) & (x[2, cand] > zp + 1e-12 * radius)]
-                tens = np.flatnonzero(active)[react < 0]
-                if pen.size or tens.size:
-                    active[pen] = True
-                    active[tens] = False
-                    du = None
-                    continue
-                if np.max(np.abs(r[free])) <= tol * scale:
-                    break
-            K = disc.tangent(tangent3(Fq, state, material, upd)).tocsc()
-            du = solver.solve(K[free][:, free], -r[free])
-            u[free] += du
-        else:
-            raise IncrementFailed(f"Newton did not converge at h = {h:g}")
-        x = X + u.reshape(-1, 3).T
-        F = 4.0 * float(np.sum(react))
-        work += 0.5 * (F + F_last) * (h - h_prev)
-        F_last = F
-        dissip = (res.dissipation[-1] if res.dissipation else 0.0) + 8.0 * disc.integrate(
-            material.flow_stress(upd.eps_p) * upd.dgamma if np.isfinite(material.sigma_y)
-            else np.zeros_like(upd.dgamma))
+    u = np.zeros(disc.n_dofs)
+    active = np.full(om.X.shape[1], -1, dtype=np.int64)
+    hist = [(0.0, u.copy())]  # (h, u) of the last two converged increments
+    lam_last = np.zeros(len(sc.flats))
+    work = dissip = 0.0
+    targets = list(np.asarray(h_values, dtype=float))[::-1]
+    cuts = 0
+    while targets:
+        h = targets[-1]
+        h_prev = hist[-1][0]
+        u_pred = hist[-1][1].copy()
+        if len(hist) > 1:
+            u_pred += (hist[-1][1] - hist[-2][1]) * (h - h_prev) / (h_prev - hist[-2][0])
+        hk = sc.approaches(h)
+        offsets = R - 0.5 * hk
+        try:
+            u_new, act_new, upd, its, tension = _increment(disc, con, solver, material, state, u_pred,
+                                                           active, offsets, tol, max_iterations)
+        except IncrementFailed as err:
+            cuts += 1
+            if cuts > MAX_CUTS:
+                res.wall_s = time.perf_counter() - t0
+                res.cpu_s = time.process_time() - c0
+                raise IncrementFailed(f"no convergence at h = {h:g} after {MAX_CUTS} cuts: {err}",
+                                      res) from err
+            targets.append(0.5 * (h + h_prev))
+            continue
+        cuts = 0
+        targets.pop()
+        u, active = u_new, act_new
+        Fq = disc.deformation_gradient(u)
+        r = disc.internal_force(upd.P)
+        lam = con.reactions(r, active)
+        lam_k = np.bincount(active[active >= 0], weights=lam[active >= 0], minlength=len(sc.flats))
+        hk_prev = sc.approaches(h_prev)
+        work += 8.0 * float(np.sum(0.5 * (lam_k + lam_last) * 0.5 * (hk - hk_prev)))
+        lam_last = lam_k
+        if np.isfinite(material.sigma_y):
+            dissip += 8.0 * disc.integrate(material.flow_stress(upd.eps_p) * upd.dgamma)
         state = PlasticState3(upd.cp_inv, upd.eps_p)
-        r_xy = np.hypot(x[0, active], x[1, active])
+        hist = [hist[-1], (h, u.copy())]
+        x = om.X + u.reshape(-1, 3).T
+        patches = [patch_measures(x, con.cand[con.cand_flat == k], con.edges, active == k,
+                                  sc.normals[k], offsets[k], sc.multiplicity[k])
+                   for k in range(len(sc.flats))]  # a few contacts, once per increment
+        vol = 8.0 * disc.integrate(np.linalg.det(Fq))
         res.h.append(float(h))
-        res.F.append(F)
-        res.A.append(4.0 * _contact_area(x, om.sphere_facets, active))
-        res.a_nodes.append(float(r_xy.max()))
+        res.hk.append(hk)
+        res.F.append(lam_k * sc.multiplicity)
+        for key in ("A", "a", "a_min", "a_max", "a_nodes"):
+            getattr(res, key).append(np.array([p[key] for p in patches]))
+        res.volume.append(vol)
+        res.density.append(sc.density(vol, h, R))
         res.work.append(work)
         res.stored.append(8.0 * disc.integrate(upd.psi))
         res.dissipation.append(dissip)
         res.newton.append(its)
-        h_prev = h
+        res.tension.append(tension)
+        res.u, res.active = u, active
         if progress is not None:
             progress(res)
+        if stop is not None and stop(res):
+            break
     res.wall_s = time.perf_counter() - t0
+    res.cpu_s = time.process_time() - c0
     return res
+
+
+def run_two_flats(material: Material, h_values, density: float = 1.0, radius: float = 1.0,
+                  **kwargs) -> CellResult:
+    """The sphere between two rigid plates (h: the change of their separation): each half is a
+    hemisphere on a flat with approach h/2, F(h) = F_ax(h/2) of the axisymmetric flat scene."""
+    return run_cell("two-flats", material, h_values, density, radius, **kwargs)

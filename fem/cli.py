@@ -24,6 +24,7 @@ from ..model.cli_args import (
     read_flow_table,
 )
 from .assembly import ELEMENTS
+from .cell_cli import add_cell_parser
 from .contact import EDGE_FITS
 from .io import SCENES, check_inputs, run_checked, write_run
 from .linsolve import METHODS as LINEAR_METHODS
@@ -333,6 +334,7 @@ def register(subparsers) -> None:
     cmds = fem.add_subparsers(dest="command", required=True, metavar="COMMAND")
     listed = _build_run_parser(cmds)
     _build_render_parser(cmds)
+    add_cell_parser(cmds, _add_material)
     fem.epilog = ("options of 'fem run' (lengths in the unit of --radius, stresses in the "
                   "unit of --E):\n" + _option_table(listed)
                   + "\n\nExit codes of 'fem run': 0 reached h-max; 2 bad input; 3 stopped early.")
