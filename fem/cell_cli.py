@@ -8,6 +8,8 @@ converged part is written with status ``stopped`` and the reason).
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import signal
 import sys
 
 import numpy as np
@@ -68,6 +70,20 @@ def pole_region(h_end: float, radius: float) -> float:
     return float(np.clip(1.15 * np.sqrt(h_end / radius), 0.4, 0.7))
 
 
+def _interrupt(signum, frame):
+    """SIGTERM as Ctrl-C: the run stops and its converged increments are written."""
+    raise KeyboardInterrupt
+
+
+def _first_increments(result, n: int):
+    """The result cut to its first n increments (an interrupt may fall between its appends)."""
+    for f in dataclasses.fields(result):
+        value = getattr(result, f.name)
+        if isinstance(value, list):
+            setattr(result, f.name, value[:n])
+    return result
+
+
 def cell_command(args: argparse.Namespace) -> int:
     """CLI handler of ``fem cell``: check, run, write, summarise; return the exit code."""
     from tqdm import tqdm
@@ -80,12 +96,16 @@ def cell_command(args: argparse.Namespace) -> int:
     bar = tqdm(total=total, file=sys.stderr, disable=disable, desc="fem cell",
                bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.4g}/{total:.4g} [{elapsed}<{remaining}]")
 
+    done = {}
+
     def progress(res):
+        done["result"], done["n"] = res, len(res.h)
         now = res.density[-1] if target is not None else res.h[-1]
         bar.update(max(now - bar.n, 0.0))
 
     stop = None if target is None else (lambda res: res.density[-1] >= target)
     status, reason = "converged", ""
+    previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
         result = run_cell(sc, material, h, density=args.mesh_density, radius=args.radius,
                           mesh_options={"pole_region": pole_region(float(h[-1]), args.radius)},
@@ -95,7 +115,13 @@ def cell_command(args: argparse.Namespace) -> int:
         if len(err.args) < 2:
             raise
         result, status, reason = err.args[1], "stopped", str(err.args[0])
+    except KeyboardInterrupt:
+        if "result" not in done:
+            raise
+        result = _first_increments(done["result"], done["n"])
+        status, reason = "stopped", "interrupted (Ctrl-C or SIGTERM); the converged increments kept"
     finally:
+        signal.signal(signal.SIGTERM, previous)
         bar.close()
     if status == "converged" and target is not None and (not result.density
                                                         or result.density[-1] < target):

@@ -93,3 +93,28 @@ def test_cli_cell_refuses_bad_input(tmp_path):
     assert cli([*base, "--lattice", "sc", "--h-max", "0.01", "--mesh-density", "3"]) == 2
     assert cli([*base, "--lattice", "sc", "--h-max", "0.01", "--E", "-1"]) == 2
     assert not out.exists()
+
+
+def test_cli_cell_interrupted_keeps_converged_increments(tmp_path, monkeypatch):
+    """Ctrl-C (or SIGTERM) after the second increment: the file holds those two increments,
+    status 'stopped', and the command exits with the stopped code."""
+    from spherecontact.fem import cell_cli
+
+    real = cell_cli.run_cell
+
+    def interrupted(*args, progress=None, **kw):
+        def report(res):
+            progress(res)
+            if len(res.h) == 2:
+                res.h.append(99.0)  # an increment half written when the interrupt comes
+                raise KeyboardInterrupt
+        return real(*args, progress=report, **kw)
+
+    monkeypatch.setattr(cell_cli, "run_cell", interrupted)
+    out = tmp_path / "cut.h5"
+    rc = cli(["--E", "200", "--sigma-y", "1", "--lattice", "sc", "--h-max", "0.004", "--dh", "0.001",
+              "--mesh-density", "0.5", "--out", str(out), "--quiet"])
+    assert rc == cell_cli.EXIT_STOPPED
+    run = read_run(out)
+    assert run.status == "stopped" and "interrupted" in run.reason
+    assert run.F.shape[0] == 2 and list(run.h_load) == [0.001, 0.002]
