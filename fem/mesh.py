@@ -84,14 +84,14 @@ def check_density(density: float) -> float:
 
 
 #: signals whose disposition gmsh's initialisation changes at the C level behind Python's back
-_KEPT_SIGNALS = (signal.SIGINT, signal.SIGPIPE)
+_KEPT_SIGNALS = (signal.SIGINT, signal.SIGPIPE, signal.SIGTERM)
 
 
 def _gmsh_initialize(gmsh) -> None:
     """``gmsh.initialize`` keeping this process's signal handlers.
 
-    gmsh's C++ initialisation resets SIGPIPE to its default (terminate) and takes SIGINT
-    from Python. A process that later writes to a closed pipe (a dead worker, a reader
+    gmsh's C++ initialisation resets SIGPIPE and SIGTERM to their defaults (terminate) and
+    takes SIGINT from Python. A process that later writes to a closed pipe (a dead worker, a reader
     that went away) would then die silently with status 141 instead of getting
     BrokenPipeError, and Ctrl-C would kill it without KeyboardInterrupt and the cleanup
     that goes with it. The Python handlers are put back (main thread only; elsewhere

@@ -118,3 +118,28 @@ def test_cli_cell_interrupted_keeps_converged_increments(tmp_path, monkeypatch):
     run = read_run(out)
     assert run.status == "stopped" and "interrupted" in run.reason
     assert run.F.shape[0] == 2 and list(run.h_load) == [0.001, 0.002]
+
+
+def test_cli_cell_sigterm_keeps_converged_increments(tmp_path):
+    """SIGTERM to a running `spherecontact fem cell` (gmsh must not take the handler away):
+    the file is written with the converged increments, status 'stopped', exit code 3."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "killed.h5"
+    exe = os.path.join(os.path.dirname(sys.executable), "spherecontact")
+    p = subprocess.Popen([exe, "fem", "cell", "--E", "200", "--sigma-y", "1", "--lattice", "sc",
+                          "--h-max", "0.1", "--dh", "0.001", "--mesh-density", "0.5", "--out", str(out),
+                          "--quiet"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(25)
+    assert p.poll() is None, "the run ended before it could be stopped"
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 3, err
+    run = read_run(out)
+    assert run.status == "stopped" and "interrupted" in run.reason
+    n = run.F.shape[0]
+    assert 1 <= n < 100 and np.allclose(run.h_load, 0.001 * np.arange(1, n + 1))
