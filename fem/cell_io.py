@@ -8,7 +8,6 @@ per-contact curves one column per flat). Written atomically as :func:`.io.write_
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,7 +17,7 @@ import numpy as np
 from ..model.material import Material
 from .cell import CellResult
 from .cell_scene import SCENES
-from .io import INPUT_PREFIX, PROVENANCE_PREFIX, _flatten, _python_value, _temporary_sibling, _unflatten
+from .io import INPUT_PREFIX, PROVENANCE_PREFIX, _flatten, _python_value, _replacing, _unflatten
 
 SCHEMA = "spherecontact.fem.cell"
 SCHEMA_VERSION = 1
@@ -38,34 +37,25 @@ def write_cell_run(path, result: CellResult, inputs: dict, status: str = "conver
     sc = SCENES[result.scene]
     arr = result.arrays()
     k = len(sc.flats)
-    tmp = _temporary_sibling(path)
-    try:
-        with h5py.File(tmp, "w") as f:
-            g = f.create_group(GROUP)
-            g.attrs.update({"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "status": status,
-                            "reason": reason, "scene": result.scene})
-            g.attrs.update(_flatten(INPUT_PREFIX, inputs))
-            prov = dict(provenance or {})
-            prov.update(wall_s=result.wall_s, cpu_s=result.cpu_s, n_nodes=result.n_nodes,
-                        n_elements=result.n_elements)
-            g.attrs.update(_flatten(PROVENANCE_PREFIX, prov))
-            c = g.create_group("contacts")
-            c.create_dataset("normal", data=sc.normals)
-            c.create_dataset("multiplicity", data=sc.multiplicity)
-            c.create_dataset("moves", data=sc.moving)
-            cv = g.create_group("curves")
-            n = len(result.h)
-            for name in CURVES:
-                cv.create_dataset(name, data=np.asarray(arr[name], dtype=float).reshape(n))
-            for name in CONTACT_CURVES:
-                cv.create_dataset(name, data=np.asarray(arr[name], dtype=float).reshape(n, k))
-            f.flush()
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with _replacing(path) as tmp, h5py.File(tmp, "w") as f:
+        g = f.create_group(GROUP)
+        g.attrs.update({"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "status": status,
+                        "reason": reason, "scene": result.scene})
+        g.attrs.update(_flatten(INPUT_PREFIX, inputs))
+        prov = dict(provenance or {})
+        prov.update(wall_s=result.wall_s, cpu_s=result.cpu_s, n_nodes=result.n_nodes,
+                    n_elements=result.n_elements)
+        g.attrs.update(_flatten(PROVENANCE_PREFIX, prov))
+        c = g.create_group("contacts")
+        c.create_dataset("normal", data=sc.normals)
+        c.create_dataset("multiplicity", data=sc.multiplicity)
+        c.create_dataset("moves", data=sc.moving)
+        cv = g.create_group("curves")
+        n = len(result.h)
+        for name in CURVES:
+            cv.create_dataset(name, data=np.asarray(arr[name], dtype=float).reshape(n))
+        for name in CONTACT_CURVES:
+            cv.create_dataset(name, data=np.asarray(arr[name], dtype=float).reshape(n, k))
     return path
 
 

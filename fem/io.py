@@ -62,6 +62,7 @@ import secrets
 import socket
 import subprocess
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
@@ -759,6 +760,29 @@ def _temporary_sibling(path: Path) -> Path:
         return tmp
 
 
+def _fsync(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+@contextmanager
+def _replacing(path: Path):
+    """Yield a temporary sibling of ``path`` to write; on success it is fsynced and renamed
+    over ``path`` (atomic), on any exception deleted, leaving ``path`` as it was."""
+    tmp = _temporary_sibling(path)
+    try:
+        yield tmp
+        _fsync(tmp)
+        os.replace(tmp, path)
+        _fsync(path.parent)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
 def write_run(path, result: RunResult, extra_provenance: dict | None = None) -> Path:
     """Write one run to the HDF5 file ``path`` atomically; return the path.
 
@@ -768,17 +792,8 @@ def write_run(path, result: RunResult, extra_provenance: dict | None = None) -> 
     """
     path = Path(path)
     prov = provenance(result, extra_provenance)
-    tmp = _temporary_sibling(path)
-    try:
-        with h5py.File(tmp, "w") as f:
-            write_run_group(f, GROUP, result, prov)
-            f.flush()
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with _replacing(path) as tmp, h5py.File(tmp, "w") as f:
+        write_run_group(f, GROUP, result, prov)
     return path
 
 

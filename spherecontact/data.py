@@ -46,7 +46,7 @@ from .fem.io import (
     INPUT_PREFIX,
     Run,
     _python_value,
-    _temporary_sibling,
+    _replacing,
     _unflatten,
     copy_run_group,
     provenance,
@@ -398,14 +398,6 @@ def _directory_lock(directory: Path):
         os.close(fd)  # closing releases the lock
 
 
-def _fsync(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
 def _check_record(record: Record, result: RunResult | None) -> None:
     """The record is consistent with the result and its key with its inputs."""
     if not isinstance(record, Record):
@@ -504,21 +496,6 @@ def remove_entries(path, keys) -> list[Record]:
             with h5py.File(tmp, "a") as f:
                 f.attrs["modified"] = _utc_now()
     return removed
-
-
-@contextmanager
-def _replacing(path: Path):
-    """Yield a temporary sibling of ``path`` to write; on success it is fsynced and renamed
-    over ``path`` (atomic), on any exception deleted, leaving ``path`` as it was."""
-    tmp = _temporary_sibling(path)
-    try:
-        yield tmp
-        _fsync(tmp)
-        os.replace(tmp, path)
-        _fsync(path.parent)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def append_run(path, record: Record, result: RunResult | None, prov: dict | None = None, *,
