@@ -26,13 +26,17 @@ xx; compression positive). Loading to ``h_max``, then unloading back to the init
 
 from __future__ import annotations
 
+import datetime
+import json
 import math
+import platform
 import time
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from .lammps_mdr import MdrScene, MdrSettings, _mdr_coeffs, _num, import_lammps
+from .lammps_mdr import MdrScene, MdrSettings, _jsonable, _mdr_coeffs, _num, import_lammps, lammps_version
 
 __all__ = ["LATTICES", "LOADS", "LatticeScene", "LatticeRun", "lattice_sites", "relative_density",
            "run_lattice"]
@@ -214,13 +218,6 @@ SCENES = {("sc", "isostatic"): 0.36, ("sc", "die"): 0.69, ("fcc", "isostatic"): 
 def generate(out, *, settings: MdrSettings | None = None, samples: int = 60, log=print) -> dict:
     """Run every scene of :data:`SCENES` for every material of :data:`MATERIALS`, write ``out``
     (JSON) and return the document."""
-    import datetime
-    import json
-    import platform
-    from pathlib import Path
-
-    from .lammps_mdr import _jsonable, lammps_version
-
     st = settings or MdrSettings()
     doc = {"schema": "spherecontact.peers.mdr_lattice", "schema_version": 1,
            "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
